@@ -1,0 +1,33 @@
+# Every external dependency, with the Debian package that provides it named in
+# the error so a missing one says what to install (`make deps` installs all).
+
+macro(ofn_require found what package)
+  if(NOT ${found})
+    message(FATAL_ERROR "${what} not found: install the Debian package '${package}' (or run `make deps`)")
+  endif()
+endmacro()
+
+# Debian's LCM 1.3.1 ships no CMake package: find header, library and lcm-gen.
+find_path(LCM_INCLUDE_DIR lcm/lcm-cpp.hpp)
+find_library(LCM_LIBRARY lcm)
+find_program(LCM_GEN lcm-gen)
+ofn_require(LCM_INCLUDE_DIR "LCM headers" liblcm-dev)
+ofn_require(LCM_LIBRARY "LCM library" liblcm-dev)
+ofn_require(LCM_GEN "lcm-gen" liblcm-bin)
+add_library(lcm::lcm UNKNOWN IMPORTED)
+set_target_properties(lcm::lcm PROPERTIES IMPORTED_LOCATION ${LCM_LIBRARY}
+                                          INTERFACE_INCLUDE_DIRECTORIES ${LCM_INCLUDE_DIR})
+
+find_package(Eigen3 3.3 QUIET NO_MODULE)
+ofn_require(Eigen3_FOUND "Eigen3" libeigen3-dev)
+find_package(yaml-cpp QUIET)
+ofn_require(yaml-cpp_FOUND "yaml-cpp" libyaml-cpp-dev)
+find_package(spdlog QUIET)
+ofn_require(spdlog_FOUND "spdlog" libspdlog-dev)
+find_package(CLI11 QUIET CONFIG)
+ofn_require(CLI11_FOUND "CLI11" libcli11-dev)
+find_package(Threads REQUIRED)
+
+# Java is only needed for the lcm-spy types jar; the flight stack builds without it.
+find_package(Java COMPONENTS Development QUIET)
+find_file(LCM_JAR lcm.jar PATHS /usr/share/java NO_DEFAULT_PATH)

@@ -1,0 +1,86 @@
+#pragma once
+// Clock objects: every service reads time from one of these, never from the
+// wall directly, so the same code runs in the field, in a real-time
+// simulation and in the deterministic lockstep runner.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace ofn {
+
+/// Microseconds since the Unix epoch (wall) or since simulation start (sim).
+using Utime = int64_t;
+
+constexpr Utime kMicrosPerSecond = 1000000;
+inline double to_seconds(Utime t) { return static_cast<double>(t) * 1e-6; }
+inline Utime to_utime(double seconds) { return static_cast<Utime>(seconds * 1e6 + (seconds >= 0 ? 0.5 : -0.5)); }
+
+class Clock {
+ public:
+  virtual ~Clock() = default;
+  virtual Utime now() const = 0;
+  /// False until the clock has a time (a SIM_CLOCK-following clock before its
+  /// first message).
+  virtual bool valid() const { return true; }
+  /// Wall seconds that pass per clock second; the process loop uses it to
+  /// sleep until the next timer. Zero means "time only advances on messages".
+  virtual double wall_seconds_per_clock_second() const { return 1.0; }
+  virtual std::string describe() const = 0;
+};
+
+/// The system clock: field deployment.
+class WallClock final : public Clock {
+ public:
+  Utime now() const override;
+  std::string describe() const override { return "wall"; }
+};
+
+/// Simulation master clock: starts at `start` and advances at
+/// `real_time_factor` times the wall (steady) clock.
+class ScaledWallClock final : public Clock {
+ public:
+  ScaledWallClock(Utime start, double real_time_factor);
+  Utime now() const override;
+  double wall_seconds_per_clock_second() const override { return 1.0 / factor_; }
+  std::string describe() const override;
+
+ private:
+  Utime start_;
+  double factor_;
+  std::chrono::steady_clock::time_point wall_start_;
+};
+
+/// Follows the SIM_CLOCK messages of the simulation master.
+class SimFollowClock final : public Clock {
+ public:
+  Utime now() const override { return now_.load(); }
+  bool valid() const override { return valid_.load(); }
+  double wall_seconds_per_clock_second() const override { return 0.0; }
+  std::string describe() const override { return "sim (follows SIM_CLOCK)"; }
+  void update(Utime t) {
+    now_.store(t);
+    valid_.store(true);
+  }
+
+ private:
+  std::atomic<Utime> now_{0};
+  std::atomic<bool> valid_{false};
+};
+
+/// Set explicitly by the lockstep scheduler; deterministic.
+class ManualClock final : public Clock {
+ public:
+  explicit ManualClock(Utime start = 0) : now_(start) {}
+  Utime now() const override { return now_; }
+  double wall_seconds_per_clock_second() const override { return 0.0; }
+  std::string describe() const override { return "lockstep"; }
+  void set(Utime t) { now_ = t; }
+
+ private:
+  Utime now_;
+};
+
+}  // namespace ofn

@@ -1,0 +1,146 @@
+#pragma once
+// A node owns one service's subscriptions, timers, counters and heartbeat on
+// a shared LCM handle. It never reads the wall clock for control decisions:
+// all times come from the Clock it is given.
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+
+#include "ofn/common/clock.hpp"
+#include "ofn/common/validate.hpp"
+
+namespace ofn {
+
+/// Receipt and rejection counters reported in the heartbeat.
+struct NodeCounters {
+  int64_t received = 0;
+  int64_t rejected = 0;
+  int64_t late = 0;
+  std::string last_reject_reason;
+  std::map<std::string, int64_t> rejected_by_reason;
+};
+
+/// Options for one subscription.
+struct SubscribeOptions {
+  /// A message whose utime is older than this (clock time) is rejected as
+  /// stale and counted as late; <= 0 disables the check.
+  double max_age = 0.0;
+  /// A message stamped further in the future than this is rejected.
+  double max_future = 1.0;
+};
+
+class Node {
+ public:
+  Node(std::string name, lcm::LCM& lcm, const Clock& clock);
+  ~Node();
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+
+  const std::string& name() const { return name_; }
+  const Clock& clock() const { return clock_; }
+  lcm::LCM& lcm() { return lcm_; }
+  spdlog::logger& log() { return *log_; }
+  const NodeCounters& counters() const { return counters_; }
+  Utime now() const { return clock_.now(); }
+
+  /// Subscribes `handler` to `channel`. Every message is decoded, checked by
+  /// validate(Msg) and for staleness; a bad one is counted, logged (rate
+  /// limited) and dropped, and the handler never sees it.
+  template <class Msg>
+  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
+                 SubscribeOptions options = {}) {
+    auto sub = std::make_unique<Subscription>();
+    sub->node = this;
+    sub->channel = channel;
+    sub->deliver = [this, handler = std::move(handler), options,
+                    channel](const lcm::ReceiveBuffer* rbuf) {
+      Msg msg;
+      if (msg.decode(rbuf->data, 0, rbuf->data_size) != static_cast<int>(rbuf->data_size)) {
+        reject(channel, "undecodable (" + std::to_string(rbuf->data_size) + " bytes)");
+        return;
+      }
+      if (std::string why = validate(msg); !why.empty()) {
+        reject(channel, why);
+        return;
+      }
+      if (!check_time(channel, msg.utime, options)) return;
+      ++counters_.received;
+      handler(msg);
+    };
+    add_subscription(std::move(sub));
+  }
+
+  template <class Msg>
+  void publish(const std::string& channel, const Msg& msg) {
+    lcm_.publish(channel, &msg);
+  }
+
+  /// Calls `callback` every `period` seconds of clock time, first at the first
+  /// tick of the node's clock that is a whole multiple of the period.
+  void add_timer(double period, std::function<void()> callback, std::string label);
+
+  /// Earliest timer deadline (clock time); INT64_MAX when there is none.
+  Utime next_deadline() const;
+  /// Runs every timer due at or before `now`. A timer that fell more than
+  /// `max_catch_up` periods behind skips ahead and counts an overrun.
+  void fire_due_timers(Utime now, int max_catch_up = 1000);
+
+  /// Counts and logs a rejected input; for checks a service makes itself.
+  void reject(const std::string& channel, const std::string& reason);
+  /// Service state reported in the heartbeat ("starting", "running", "degraded").
+  void set_state(std::string state) { state_ = std::move(state); }
+
+ private:
+  struct Subscription {
+    Node* node = nullptr;
+    std::string channel;
+    std::function<void(const lcm::ReceiveBuffer*)> deliver;
+    lcm::Subscription* handle = nullptr;
+  };
+  struct Timer {
+    double period;
+    Utime period_us;
+    Utime deadline;  // INT64_MIN until scheduled from the first valid clock
+    std::function<void()> callback;
+    std::string label;
+    int64_t overruns = 0;
+  };
+
+  static void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Subscription* sub);
+  void add_subscription(std::unique_ptr<Subscription> sub);
+  bool check_time(const std::string& channel, Utime stamp, const SubscribeOptions& options);
+  void publish_heartbeat();
+  void account_work(std::chrono::steady_clock::duration busy);
+
+  std::string name_;
+  lcm::LCM& lcm_;
+  const Clock& clock_;
+  std::shared_ptr<spdlog::logger> log_;
+  std::vector<std::unique_ptr<Subscription>> subscriptions_;
+  std::vector<Timer> timers_;
+  NodeCounters counters_;
+  std::string state_ = "starting";
+  Utime start_time_ = INT64_MIN;
+
+  // Work statistics over the current heartbeat period (wall time: it
+  // measures CPU cost, it does not drive behaviour).
+  int64_t work_calls_ = 0;
+  double work_total_ = 0.0;
+  double work_max_ = 0.0;
+  std::chrono::steady_clock::time_point period_start_;
+  // Rate limit for rejection log lines.
+  Utime last_reject_log_ = INT64_MIN;
+  int64_t suppressed_rejects_ = 0;
+};
+
+/// Heartbeat channel of a service: HEARTBEAT_<NAME>.
+std::string heartbeat_channel(const std::string& service);
+
+}  // namespace ofn

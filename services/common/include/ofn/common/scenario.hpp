@@ -1,0 +1,55 @@
+#pragma once
+// A scenario file (YAML) describes one course: units, start state,
+// waypoints, limits, timing gates and environment. Everything is converted
+// to SI and world NED on load. See docs/SCENARIO_FORMAT.md.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ofn/common/frames.hpp"
+
+namespace ofn {
+
+struct Limits {
+  double max_speed = 0;           // m/s
+  double max_accel = 0;           // m/s^2, total
+  double max_vertical_speed = 0;  // m/s
+  double min_forward_speed = 0;   // m/s
+  double clearance = 0;           // m
+  double sensor_range = 0;        // m
+};
+
+struct Waypoint {
+  Vec3 position = Vec3::Zero();  // m, world NED
+  double capture_radius = 0;     // m
+};
+
+struct Scenario {
+  std::string name;
+  std::string description;
+  std::string file;
+  std::string display_unit = "m";  // unit the file was written in, used for reports
+  double metres_per_unit = 1.0;
+
+  Vec3 start_position = Vec3::Zero();  // m, world NED
+  Vec3 start_velocity = Vec3::Zero();  // m/s, world NED
+  double start_heading = 0;            // rad from north
+
+  std::vector<Waypoint> waypoints;
+  double cruise_speed = 0;  // m/s
+  Limits limits;
+
+  /// North coordinates (m) of the timing gate lines; the clock starts at the
+  /// first crossing of start_gate and stops at the first of finish_gate.
+  std::optional<double> start_gate;
+  std::optional<double> finish_gate;
+
+  Vec3 wind = Vec3::Zero();  // m/s, world NED, velocity of the air mass
+  double max_time = 600;     // s of simulated time before a run is abandoned
+};
+
+/// Loads and checks a scenario; throws ConfigError naming the file and field.
+Scenario load_scenario(const std::string& path);
+
+}  // namespace ofn

@@ -1,0 +1,47 @@
+#pragma once
+// What every service's main() shares: the common command-line options, the
+// clock they select and the process loop that runs nodes on a udpm:// (or
+// any) LCM URL until SIGINT/SIGTERM.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include "ofn/common/clock.hpp"
+#include "ofn/common/node.hpp"
+
+namespace ofn {
+
+/// Default bus: LCM's multicast group with TTL 0, so simulation traffic
+/// never leaves the machine unless a deployment asks for it.
+inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
+
+struct CommonOptions {
+  std::string config;      // service config file (YAML); empty: defaults
+  std::string lcm_url;     // empty: $LCM_DEFAULT_URL or kDefaultLcmUrl
+  std::string clock = "wall";
+  std::string log_level = "info";
+};
+
+void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock = true);
+
+/// Applies the log level and opens the LCM handle; throws with a clear
+/// message if the URL cannot be opened.
+std::unique_ptr<lcm::LCM> open_lcm(const CommonOptions& options);
+
+/// The clock named by --clock: "wall" or "sim" (follows SIM_CLOCK).
+std::unique_ptr<Clock> make_clock(const std::string& kind);
+
+/// Runs the nodes until SIGINT/SIGTERM (or until `keep_running` says no).
+/// A SimFollowClock is fed from SIM_CLOCK. Returns a process exit code.
+int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
+              const std::function<bool()>& keep_running = {});
+
+/// Wraps a service main so that configuration errors and other exceptions
+/// end the process with a clear message and exit code 2 instead of a crash.
+int guarded_main(const std::string& program, const std::function<int()>& body);
+
+}  // namespace ofn

@@ -1,0 +1,153 @@
+#include "ofn/common/node.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <climits>
+
+#include "ofn/common/channels.hpp"
+#include "ofn/common/logging.hpp"
+#include "ofn/heartbeat_t.hpp"
+
+namespace ofn {
+
+std::string heartbeat_channel(const std::string& service) {
+  std::string channel = channels::kHeartbeatPrefix;
+  for (char c : service) channel += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return channel;
+}
+
+Node::Node(std::string name, lcm::LCM& lcm, const Clock& clock)
+    : name_(std::move(name)),
+      lcm_(lcm),
+      clock_(clock),
+      log_(make_logger(name_)),
+      period_start_(std::chrono::steady_clock::now()) {
+  add_timer(1.0, [this] { publish_heartbeat(); }, "heartbeat");
+}
+
+Node::~Node() {
+  for (auto& sub : subscriptions_)
+    if (sub->handle) lcm_.unsubscribe(sub->handle);
+}
+
+void Node::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscription* sub) {
+  const auto begin = std::chrono::steady_clock::now();
+  sub->deliver(rbuf);
+  sub->node->account_work(std::chrono::steady_clock::now() - begin);
+}
+
+void Node::add_subscription(std::unique_ptr<Subscription> sub) {
+  sub->handle = lcm_.subscribeFunction(sub->channel, &Node::on_raw, sub.get());
+  subscriptions_.push_back(std::move(sub));
+}
+
+bool Node::check_time(const std::string& channel, Utime stamp, const SubscribeOptions& options) {
+  if (!clock_.valid()) return true;  // nothing to compare with yet
+  const Utime now = clock_.now();
+  if (options.max_future > 0 && stamp > now + to_utime(options.max_future)) {
+    reject(channel, "stamped " + std::to_string(to_seconds(stamp - now)) + " s in the future");
+    return false;
+  }
+  if (options.max_age > 0 && now - stamp > to_utime(options.max_age)) {
+    ++counters_.late;
+    reject(channel, "stale by " + std::to_string(to_seconds(now - stamp)) + " s");
+    return false;
+  }
+  return true;
+}
+
+void Node::reject(const std::string& channel, const std::string& reason) {
+  ++counters_.rejected;
+  counters_.last_reject_reason = channel + ": " + reason;
+  ++counters_.rejected_by_reason[counters_.last_reject_reason];
+  // One line per second at most, so a flood of bad input cannot flood the log.
+  const Utime now = clock_.valid() ? clock_.now() : 0;
+  if (last_reject_log_ == INT64_MIN || now - last_reject_log_ >= kMicrosPerSecond ||
+      now < last_reject_log_) {
+    log_->warn("rejected {} ({} total{})", counters_.last_reject_reason, counters_.rejected,
+               suppressed_rejects_ ? ", " + std::to_string(suppressed_rejects_) + " not logged" : "");
+    last_reject_log_ = now;
+    suppressed_rejects_ = 0;
+  } else {
+    ++suppressed_rejects_;
+  }
+}
+
+void Node::add_timer(double period, std::function<void()> callback, std::string label) {
+  if (!(period > 0)) throw std::invalid_argument("timer '" + label + "': period must be > 0");
+  Timer t;
+  t.period = period;
+  t.period_us = std::max<Utime>(1, to_utime(period));
+  t.deadline = INT64_MIN;
+  t.callback = std::move(callback);
+  t.label = std::move(label);
+  timers_.push_back(std::move(t));
+}
+
+Utime Node::next_deadline() const {
+  Utime next = INT64_MAX;
+  for (const auto& t : timers_) next = std::min(next, t.deadline == INT64_MIN ? INT64_MIN : t.deadline);
+  return next;
+}
+
+void Node::fire_due_timers(Utime now, int max_catch_up) {
+  if (!clock_.valid()) return;
+  if (start_time_ == INT64_MIN) start_time_ = now;
+  for (auto& t : timers_) {
+    if (t.deadline == INT64_MIN) {
+      // Align to whole multiples of the period so that lockstep runs are
+      // reproducible and rates line up across services.
+      t.deadline = (now / t.period_us) * t.period_us;
+      if (t.deadline < now) t.deadline += t.period_us;
+    }
+    int fired = 0;
+    while (t.deadline <= now) {
+      if (fired == max_catch_up) {
+        const Utime behind = (now - t.deadline) / t.period_us + 1;
+        t.overruns += behind;
+        t.deadline += behind * t.period_us;
+        log_->warn("timer '{}' fell {} periods behind; skipped ahead", t.label, behind);
+        break;
+      }
+      const auto begin = std::chrono::steady_clock::now();
+      t.callback();
+      account_work(std::chrono::steady_clock::now() - begin);
+      t.deadline += t.period_us;
+      ++fired;
+    }
+  }
+}
+
+void Node::account_work(std::chrono::steady_clock::duration busy) {
+  const double s = std::chrono::duration<double>(busy).count();
+  ++work_calls_;
+  work_total_ += s;
+  work_max_ = std::max(work_max_, s);
+}
+
+void Node::publish_heartbeat() {
+  const auto wall_now = std::chrono::steady_clock::now();
+  const double wall_period = std::chrono::duration<double>(wall_now - period_start_).count();
+  heartbeat_t hb;
+  hb.utime = clock_.now();
+  hb.service = name_;
+  hb.pid = static_cast<int32_t>(::getpid());
+  hb.state = state_;
+  hb.received = counters_.received;
+  hb.rejected = counters_.rejected;
+  hb.late = counters_.late;
+  hb.last_reject_reason = counters_.last_reject_reason;
+  hb.loop_time_mean = work_calls_ ? work_total_ / static_cast<double>(work_calls_) : 0.0;
+  hb.loop_time_max = work_max_;
+  hb.cpu_fraction = wall_period > 0 ? work_total_ / wall_period : 0.0;
+  hb.uptime = start_time_ == INT64_MIN ? 0.0 : to_seconds(hb.utime - start_time_);
+  publish(heartbeat_channel(name_), hb);
+  work_calls_ = 0;
+  work_total_ = 0.0;
+  work_max_ = 0.0;
+  period_start_ = wall_now;
+}
+
+}  // namespace ofn

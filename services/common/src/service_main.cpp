@@ -1,0 +1,106 @@
+#include "ofn/common/service_main.hpp"
+
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <iostream>
+
+#include "ofn/common/channels.hpp"
+#include "ofn/common/config.hpp"
+#include "ofn/common/logging.hpp"
+#include "ofn/sim_clock_t.hpp"
+
+namespace ofn {
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop.store(true); }
+
+}  // namespace
+
+void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock) {
+  app.add_option("--config", options.config, "service configuration file (YAML)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--lcm-url", options.lcm_url,
+                 "LCM URL (default: $LCM_DEFAULT_URL or " + std::string(kDefaultLcmUrl) + ")");
+  if (with_clock)
+    app.add_option("--clock", options.clock,
+                   "time source: wall (field) or sim (follow SIM_CLOCK from vehicle_sim)")
+        ->check(CLI::IsMember({"wall", "sim"}));
+  app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+}
+
+std::unique_ptr<lcm::LCM> open_lcm(const CommonOptions& options) {
+  set_log_level(options.log_level);
+  std::string url = options.lcm_url;
+  if (url.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    url = env && *env ? env : kDefaultLcmUrl;
+  }
+  auto lcm = std::make_unique<lcm::LCM>(url);
+  if (!lcm->good())
+    throw std::runtime_error("cannot open LCM at '" + url +
+                             "' (is multicast routed? try: ip route add 224.0.0.0/4 dev lo)");
+  return lcm;
+}
+
+std::unique_ptr<Clock> make_clock(const std::string& kind) {
+  if (kind == "wall") return std::make_unique<WallClock>();
+  if (kind == "sim") return std::make_unique<SimFollowClock>();
+  throw std::invalid_argument("unknown clock '" + kind + "' (expected wall or sim)");
+}
+
+int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
+              const std::function<bool()>& keep_running) {
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  // A following clock advances on SIM_CLOCK; timers then fire on the
+  // message, so each service steps in simulation time.
+  auto* follower = dynamic_cast<SimFollowClock*>(&clock);
+  std::unique_ptr<Node> clock_node;
+  if (follower) {
+    clock_node = std::make_unique<Node>("sim_clock", lcm, clock);
+    clock_node->subscribe<sim_clock_t>(
+        channels::kSimClock, [follower](const sim_clock_t& m) { follower->update(m.utime); },
+        SubscribeOptions{0.0, 0.0});
+  }
+
+  while (!g_stop.load() && (!keep_running || keep_running())) {
+    const Utime now = clock.now();
+    Utime next = INT64_MAX;
+    for (Node* node : nodes) {
+      node->fire_due_timers(now);
+      next = std::min(next, node->next_deadline());
+    }
+    int wait_ms = 50;
+    const double scale = clock.wall_seconds_per_clock_second();
+    if (scale > 0 && next != INT64_MAX) {
+      const double wait = to_seconds(next - clock.now()) * scale;
+      wait_ms = static_cast<int>(std::clamp(wait * 1000.0, 0.0, 50.0));
+    }
+    if (lcm.handleTimeout(wait_ms) < 0) {
+      std::cerr << "LCM receive failed; stopping\n";
+      return 1;
+    }
+    // Drain whatever else arrived before running timers again.
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  }
+  return 0;
+}
+
+int guarded_main(const std::string& program, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const ConfigError& e) {
+    std::cerr << program << ": configuration error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << program << ": " << e.what() << "\n";
+    return 2;
+  }
+}
+
+}  // namespace ofn

@@ -1,0 +1,207 @@
+#include "ofn/common/validate.hpp"
+
+#include <algorithm>
+
+namespace ofn {
+namespace {
+
+const char* kFrame = "NED";
+
+bool within_world(const double (&p)[3]) {
+  return all_finite(p) && std::abs(p[0]) < MessageLimits::kMaxCoordinate &&
+         std::abs(p[1]) < MessageLimits::kMaxCoordinate &&
+         std::abs(p[2]) < MessageLimits::kMaxCoordinate;
+}
+
+std::string check_count(int32_t count, size_t actual, int32_t max, const char* what) {
+  if (count < 0) return std::string("negative ") + what + " count";
+  if (count > max) return std::string("too many ") + what + " (" + std::to_string(count) + " > " +
+                          std::to_string(max) + ")";
+  if (static_cast<size_t>(count) != actual) return std::string(what) + " count does not match";
+  return "";
+}
+
+std::string check_frame(const std::string& frame) {
+  return frame == kFrame ? "" : "frame '" + frame + "' is not NED";
+}
+
+}  // namespace
+
+std::string validate(const nav_state_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (!within_world(m.position)) return "position not finite or out of range";
+  if (!all_finite(m.velocity) || !all_finite(m.acceleration)) return "velocity/acceleration not finite";
+  if (!all_finite(m.quaternion) || !all_finite(m.euler) || !all_finite(m.body_rates))
+    return "attitude not finite";
+  const double qn = std::sqrt(m.quaternion[0] * m.quaternion[0] + m.quaternion[1] * m.quaternion[1] +
+                              m.quaternion[2] * m.quaternion[2] + m.quaternion[3] * m.quaternion[3]);
+  if (std::abs(qn - 1.0) > 1e-3) return "quaternion not normalised";
+  return "";
+}
+
+std::string validate(const actuator_cmd_t& m) {
+  const double v[4] = {m.collective, m.lon_cyclic, m.lat_cyclic, m.pedal};
+  if (!all_finite(v)) return "actuator command not finite";
+  for (double x : v)
+    if (std::abs(x) > 1.0) return "actuator command beyond 1 rad";
+  return "";
+}
+
+std::string validate(const sim_clock_t& m) {
+  if (m.utime < 0) return "negative simulation time";
+  if (!std::isfinite(m.real_time_factor) || m.real_time_factor <= 0) return "bad real-time factor";
+  return "";
+}
+
+std::string validate(const mission_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (auto e = check_count(m.num_waypoints, m.waypoints.size(), MessageLimits::kMaxWaypoints,
+                           "waypoints");
+      !e.empty())
+    return e;
+  const auto& l = m.limits;
+  const double lim[6] = {l.max_speed, l.max_accel, l.max_vertical_speed, l.min_forward_speed,
+                         l.clearance, l.sensor_range};
+  if (!all_finite(lim)) return "limits not finite";
+  if (l.max_speed <= 0 || l.max_accel <= 0 || l.max_vertical_speed <= 0) return "limits not positive";
+  if (l.clearance < 0 || l.sensor_range < 0) return "negative clearance or sensor range";
+  if (!(m.cruise_speed > 0) || m.cruise_speed > l.max_speed * (1 + 1e-9))
+    return "cruise speed not in (0, max_speed]";
+  for (const auto& wp : m.waypoints) {
+    if (!within_world(wp.position)) return "waypoint not finite or out of range";
+    if (!(wp.capture_radius > 0) || !std::isfinite(wp.capture_radius))
+      return "waypoint capture radius not positive";
+  }
+  return "";
+}
+
+std::string validate(const virtual_obstacles_t& m) {
+  if (auto e = check_count(m.num_obstacles, m.obstacles.size(), MessageLimits::kMaxObstacles,
+                           "obstacles");
+      !e.empty())
+    return e;
+  if (!std::isfinite(m.ground_altitude)) return "ground altitude not finite";
+  for (const auto& o : m.obstacles) {
+    if (o.kind < obstacle_t::BOX || o.kind > obstacle_t::TREE) return "unknown obstacle kind";
+    const double v[5] = {o.center[0], o.center[1], o.size[0], o.size[1], o.height};
+    if (!all_finite(v) || !std::isfinite(o.yaw)) return "obstacle not finite";
+    if (o.size[0] <= 0 || o.size[1] <= 0 || o.height <= 0) return "obstacle size not positive";
+  }
+  return "";
+}
+
+std::string validate(const lidar_scan_t& m) {
+  const size_t n = m.range.size();
+  if (auto e = check_count(m.num_beams, n, MessageLimits::kMaxBeams, "beams"); !e.empty()) return e;
+  if (m.beam_dt_us.size() != n || m.elevation.size() != n || m.layer_angle.size() != n ||
+      m.status.size() != n)
+    return "beam arrays differ in length";
+  if (!(m.max_range > 0) || !std::isfinite(m.max_range)) return "max range not positive";
+  if (!all_finite(m.elevation.begin(), m.elevation.end()) ||
+      !all_finite(m.layer_angle.begin(), m.layer_angle.end()))
+    return "beam angle not finite";
+  for (size_t i = 0; i < n; ++i) {
+    if (m.status[i] < lidar_scan_t::OK || m.status[i] > lidar_scan_t::MAX_RANGE)
+      return "unknown beam status";
+    // A range is only meaningful on an OK beam; a NaN there is a corrupt scan.
+    if (m.status[i] == lidar_scan_t::OK && !(std::isfinite(m.range[i]) && m.range[i] >= 0))
+      return "range not finite";
+    if (m.beam_dt_us[i] < 0) return "negative beam time offset";
+  }
+  return "";
+}
+
+std::string validate(const scan_world_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (auto e = check_count(m.num_points, m.points.size(), MessageLimits::kMaxScanPoints, "points");
+      !e.empty())
+    return e;
+  if (!within_world(m.sensor_origin)) return "sensor origin not finite";
+  for (const auto& p : m.points)
+    if (!all_finite(p.begin(), p.end()) || p.size() != 3) return "point not finite";
+  return "";
+}
+
+std::string validate(const obstacle_grid_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (m.rows <= 0 || m.cols <= 0) return "grid dimensions not positive";
+  if (static_cast<int64_t>(m.rows) * m.cols != m.num_cells) return "cell count != rows * cols";
+  if (auto e = check_count(m.num_cells, m.top_altitude.size(), MessageLimits::kMaxGridCells,
+                           "cells");
+      !e.empty())
+    return e;
+  if (!(m.resolution > 0) || !std::isfinite(m.resolution)) return "resolution not positive";
+  if (!all_finite(m.origin) || !std::isfinite(m.safety_margin)) return "grid geometry not finite";
+  if (!all_finite(m.top_altitude.begin(), m.top_altitude.end())) return "cell not finite";
+  return "";
+}
+
+std::string validate(const cuboid_list_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (auto e = check_count(m.num_cuboids, m.cuboids.size(), MessageLimits::kMaxCuboids, "cuboids");
+      !e.empty())
+    return e;
+  for (const auto& c : m.cuboids) {
+    if (!within_world(c.min_corner) || !within_world(c.max_corner)) return "cuboid not finite";
+    for (int k = 0; k < 3; ++k)
+      if (c.min_corner[k] > c.max_corner[k]) return "cuboid min corner above max corner";
+  }
+  return "";
+}
+
+std::string validate(const global_path_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (auto e = check_count(m.num_points, m.points.size(), MessageLimits::kMaxPathPoints, "points");
+      !e.empty())
+    return e;
+  if (m.status < global_path_t::OK || m.status > global_path_t::NO_PATH) return "unknown status";
+  for (const auto& p : m.points)
+    if (p.size() != 3 || !all_finite(p.begin(), p.end())) return "path point not finite";
+  return "";
+}
+
+std::string validate(const ref_traj_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (auto e = check_count(m.num_samples, m.sample_time.size(), MessageLimits::kMaxTrajSamples,
+                           "samples");
+      !e.empty())
+    return e;
+  if (m.num_samples < 2) return "fewer than two samples";
+  const size_t n = m.sample_time.size();
+  if (m.position.size() != n || m.velocity.size() != n || m.acceleration.size() != n)
+    return "sample arrays differ in length";
+  if (m.num_knots != static_cast<int32_t>(m.knots.size()) ||
+      m.num_control_points != static_cast<int32_t>(m.control_points.size()))
+    return "spline counts do not match";
+  if (m.num_control_points > 0 && m.num_knots != m.num_control_points + m.degree + 1)
+    return "knot count != control points + degree + 1";
+  if (!all_finite(m.sample_time.begin(), m.sample_time.end())) return "sample time not finite";
+  for (size_t i = 1; i < n; ++i)
+    if (!(m.sample_time[i] > m.sample_time[i - 1])) return "sample times not increasing";
+  for (size_t i = 0; i < n; ++i) {
+    for (const auto* v : {&m.position[i], &m.velocity[i], &m.acceleration[i]})
+      if (v->size() != 3 || !all_finite(v->begin(), v->end())) return "sample not finite";
+  }
+  return "";
+}
+
+std::string validate(const solver_stats_t& m) {
+  const double v[3] = {m.solve_time, m.max_constraint_violation, m.cost};
+  if (!all_finite(v)) return "statistics not finite";
+  return "";
+}
+
+std::string validate(const control_status_t& m) {
+  if (!all_finite(m.ref_position) || !all_finite(m.ref_velocity) ||
+      !all_finite(m.ref_acceleration) || !all_finite(m.commanded_acceleration) ||
+      !all_finite(m.position_error) || !all_finite(m.adaptive_output))
+    return "status not finite";
+  return "";
+}
+
+std::string validate(const heartbeat_t& m) {
+  if (m.service.empty()) return "no service name";
+  return "";
+}
+
+}  // namespace ofn

@@ -1,0 +1,74 @@
+#pragma once
+// Binds guidance and the trajectory follower to the bus. Chooses the
+// reference each step: a fresh REF_TRAJ (avoidance) overrides nominal
+// waypoint guidance; without a mission the vehicle holds position; without
+// fresh navigation it commands a level hover.
+
+#include <optional>
+
+#include "ofn/common/config.hpp"
+#include "ofn/common/node.hpp"
+#include "ofn/controller/trajectory_controller.hpp"
+#include "ofn/controller/waypoint_guidance.hpp"
+#include "ofn/mission_t.hpp"
+#include "ofn/nav_state_t.hpp"
+#include "ofn/ref_traj_t.hpp"
+
+namespace ofn::control {
+
+struct YawSweep {
+  bool enabled = false;
+  double frequency = 0.2;          // Hz
+  double total_angle = deg2rad(40);  // rad, peak to peak
+};
+
+struct ControllerConfig {
+  double rate = 100.0;            // Hz, control loop and ACTUATOR_CMD
+  double status_rate = 50.0;      // Hz, CONTROL_STATUS
+  double nav_timeout = 0.2;       // s; older navigation counts as lost
+  double ref_traj_timeout = 0.5;  // s; an older REF_TRAJ is no longer followed
+  ControllerGains gains;
+  GuidanceConfig guidance;
+  YawSweep sweep;
+  vehicle::RotorcraftParams nominal;  // the controller's model of the airframe
+};
+
+ControllerConfig load_controller_config(YamlReader& reader);
+
+/// Reference from a REF_TRAJ at time t (seconds after its t0), by linear
+/// interpolation of its samples; nullopt outside the sampled span.
+std::optional<Reference> sample_ref_traj(const ref_traj_t& traj, Utime now);
+
+class ControllerService {
+ public:
+  ControllerService(lcm::LCM& lcm, const Clock& clock, ControllerConfig config);
+  Node& node() { return node_; }
+  int8_t mode() const { return mode_; }
+
+ private:
+  void on_nav(const nav_state_t& m) { nav_ = m; }
+  void on_mission(const mission_t& m);
+  void on_ref_traj(const ref_traj_t& m) { ref_traj_ = m; }
+  void control_step();
+  void publish_status();
+  double yaw_reference(const Vec3& leg_direction, double* yaw_rate);
+
+  Node node_;
+  ControllerConfig config_;
+  TrajectoryController controller_;
+  WaypointGuidance guidance_;
+  std::optional<nav_state_t> nav_;
+  std::optional<mission_t> mission_;
+  bool mission_pending_ = false;
+  std::optional<ref_traj_t> ref_traj_;
+  int8_t mode_ = control_status_t::HOLD;
+  Vec3 hold_position_ = Vec3::Zero();
+  double path_yaw_ = 0;
+  bool path_yaw_set_ = false;
+  int active_waypoint_ = -1;
+  Reference last_ref_;
+  ControlOutput last_out_;
+  Utime last_step_ = INT64_MIN;
+};
+
+}  // namespace ofn::control

@@ -1,0 +1,116 @@
+#pragma once
+// Trajectory follower by approximate model inversion (after Johnson and
+// Kannan's adaptive trajectory controller, paper Fig. 2):
+//   outer loop: position/velocity errors -> acceleration pseudo-control
+//               (reference feed-forward + PID - adaptive share) -> inverted to
+//               a thrust vector, i.e. collective and a desired attitude;
+//   inner loop: attitude/rate errors -> angular-acceleration pseudo-control
+//               -> inverted through the nominal rotor model to cyclic and pedal.
+// The adaptive element plugs in through AdaptiveElement; the default one
+// adds nothing. Pure core: no LCM, no clock (dt is passed in).
+
+#include <memory>
+
+#include "ofn/common/frames.hpp"
+#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+
+namespace ofn::control {
+
+struct Reference {
+  Vec3 position = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 acceleration = Vec3::Zero();
+  double yaw = 0;       // rad
+  double yaw_rate = 0;  // rad/s
+};
+
+struct VehicleEstimate {
+  Vec3 position = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Quat attitude = Quat::Identity();
+  Vec3 body_rates = Vec3::Zero();
+};
+
+struct ControllerGains {
+  // Outer loop per world axis (north, east, down).
+  Vec3 position = Vec3(0.64, 0.64, 1.0);      // 1/s^2
+  Vec3 velocity = Vec3(1.44, 1.44, 1.8);      // 1/s
+  Vec3 integral = Vec3(0.04, 0.04, 0.1);      // 1/s^3
+  double integral_limit = 1.0;                // m/s^2, largest integral share
+  double max_horizontal_accel = 3.0;          // m/s^2, pseudo-control bound
+  double max_vertical_accel = 3.0;            // m/s^2
+  double max_tilt = deg2rad(25.0);            // rad
+  // Inner loop per body axis (roll, pitch, yaw).
+  Vec3 attitude = Vec3(9.0, 9.0, 4.0);        // 1/s^2
+  Vec3 rate = Vec3(4.8, 4.8, 4.0);            // 1/s
+  Vec3 attitude_integral = Vec3(2.0, 2.0, 1.0);  // 1/s^3
+  double attitude_integral_limit = 2.0;       // rad/s^2
+};
+
+/// Inputs an adaptive element sees each step.
+struct AdaptiveInputs {
+  Vec3 position_error, velocity_error;     // reference - actual, world
+  Vec3 attitude_error, rate_error;         // body
+  Vec3 pseudo_accel, pseudo_angular;       // pseudo-controls before the adaptive share
+  Vec3 velocity, body_rates;
+  double dt = 0;
+};
+
+/// The slot for an online adaptive element (e.g. a neural network with a
+/// bounded update law). It returns the share subtracted from each loop's
+/// pseudo-control and learns from the tracking errors.
+class AdaptiveElement {
+ public:
+  virtual ~AdaptiveElement() = default;
+  virtual Vec3 outer_output(const AdaptiveInputs& in) = 0;
+  virtual Vec3 inner_output(const AdaptiveInputs& in) = 0;
+  virtual void update(const AdaptiveInputs& in) = 0;
+  virtual void reset() = 0;
+};
+
+/// Adds nothing: the non-adaptive baseline.
+class NoAdaptation final : public AdaptiveElement {
+ public:
+  Vec3 outer_output(const AdaptiveInputs&) override { return Vec3::Zero(); }
+  Vec3 inner_output(const AdaptiveInputs&) override { return Vec3::Zero(); }
+  void update(const AdaptiveInputs&) override {}
+  void reset() override {}
+};
+
+struct ControlOutput {
+  vehicle::Controls controls;
+  Vec3 commanded_accel = Vec3::Zero();   // outer-loop pseudo-control, world NED
+  Vec3 adaptive_accel = Vec3::Zero();    // adaptive share of it
+  Quat attitude_command = Quat::Identity();
+  double thrust = 0;                     // N
+  bool saturated = false;                // an actuator or pseudo-control bound was hit
+  bool valid = true;                     // false: non-finite result replaced by a safe command
+};
+
+class TrajectoryController {
+ public:
+  /// `nominal` is the controller's own (approximate) model of the airframe.
+  explicit TrajectoryController(vehicle::RotorcraftParams nominal, ControllerGains gains = {},
+                                std::unique_ptr<AdaptiveElement> adaptive = nullptr);
+
+  ControlOutput step(const Reference& ref, const VehicleEstimate& x, double dt);
+  /// Forgets integrators and adaptation (mode changes, restarts).
+  void reset();
+  /// Level-attitude hover command, the safe output when inputs are bad.
+  vehicle::Controls hover_command() const { return hover_; }
+  const ControllerGains& gains() const { return gains_; }
+  const vehicle::RotorcraftModel& nominal_model() const { return model_; }
+
+ private:
+  double collective_for_thrust(double thrust, const Vec3& air_body) const;
+
+  vehicle::RotorcraftModel model_;
+  ControllerGains gains_;
+  std::unique_ptr<AdaptiveElement> adaptive_;
+  vehicle::Controls hover_;
+  Vec3 position_integral_ = Vec3::Zero();
+  Vec3 attitude_integral_ = Vec3::Zero();
+  double tail_thrust_estimate_ = 0;  // N, side force of the tail rotor
+};
+
+}  // namespace ofn::control

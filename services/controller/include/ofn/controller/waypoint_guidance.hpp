@@ -1,0 +1,67 @@
+#pragma once
+// Nominal waypoint guidance (the baseline planner of paper Fig. 1): straight
+// legs between waypoints flown at cruise speed, speeding up and slowing down
+// within a fraction of the acceleration limit, switching to the next leg
+// inside the waypoint's capture radius and stopping at the last waypoint.
+// Pure core: positions in world NED, SI units.
+
+#include <vector>
+
+#include "ofn/common/frames.hpp"
+#include "ofn/common/scenario.hpp"
+
+namespace ofn::control {
+
+struct GuidanceConfig {
+  double accel_fraction = 0.8;  // of limits.max_accel used by the reference
+  double speed_gain = 1.0;      // 1/s, how briskly the reference speed follows its target
+  double jerk_fraction = 0.5;   // 1/s: jerk limit as a multiple of limits.max_accel per second
+  double max_lead = 8.0;        // m the reference may run ahead of the vehicle along track
+  double stop_speed = 0.3;      // m/s, at or below this at the last waypoint counts as arrived
+};
+
+struct GuidanceReference {
+  Vec3 position = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 acceleration = Vec3::Zero();
+  Vec3 leg_direction = Vec3::UnitX();  // unit vector of the active leg
+  int active_waypoint = -1;             // index of the waypoint flown to; -1 without mission
+  bool done = false;                    // arrived at the last waypoint
+};
+
+class WaypointGuidance {
+ public:
+  explicit WaypointGuidance(GuidanceConfig config = {}) : config_(config) {}
+
+  /// Starts a plan. The first leg is the one nearest the vehicle, so a
+  /// controller restarted mid-flight picks up where the vehicle is.
+  void set_mission(const std::vector<Waypoint>& waypoints, double cruise_speed,
+                   const Limits& limits, const Vec3& position, const Vec3& velocity);
+  void clear() { waypoints_.clear(); }
+  bool has_mission() const { return !waypoints_.empty(); }
+
+  /// Puts the reference back at the vehicle's projection on the active leg,
+  /// after another source of reference (avoidance) has been flown.
+  void resync(const Vec3& position, const Vec3& velocity);
+
+  /// Advances the reference by dt and returns it.
+  GuidanceReference update(const Vec3& position, const Vec3& velocity, double dt);
+
+ private:
+  void start_leg(const Vec3& from, int to_index, double speed_along);
+  double leg_speed_limit() const;
+  bool final_leg() const { return active_ + 1 == static_cast<int>(waypoints_.size()); }
+
+  GuidanceConfig config_;
+  std::vector<Waypoint> waypoints_;
+  double cruise_speed_ = 0;
+  Limits limits_;
+  int active_ = -1;
+  Vec3 leg_start_ = Vec3::Zero();
+  Vec3 leg_dir_ = Vec3::UnitX();
+  double leg_length_ = 0;
+  double s_ = 0, s_dot_ = 0, s_ddot_ = 0;
+  bool done_ = false;
+};
+
+}  // namespace ofn::control

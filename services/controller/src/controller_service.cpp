@@ -1,0 +1,237 @@
+#include "ofn/controller/controller_service.hpp"
+
+#include "ofn/actuator_cmd_t.hpp"
+#include "ofn/common/channels.hpp"
+#include "ofn/control_status_t.hpp"
+
+namespace ofn::control {
+namespace {
+
+Vec3 vec(const double (&a)[3]) { return Vec3(a[0], a[1], a[2]); }
+Vec3 vec(const std::vector<double>& a) { return Vec3(a[0], a[1], a[2]); }
+void put(double (&dst)[3], const Vec3& v) {
+  for (int i = 0; i < 3; ++i) dst[i] = v[i];
+}
+Vec3 read_vec3(YamlReader& r, const std::string& key, const Vec3& fallback) {
+  const auto v = r.numbers(key, {fallback.x(), fallback.y(), fallback.z()});
+  for (double x : v)
+    if (x < 0) r.fail(key, "gains must be >= 0");
+  return vec(v);
+}
+
+}  // namespace
+
+ControllerConfig load_controller_config(YamlReader& r) {
+  ControllerConfig c;
+  c.rate = r.number_in("rate_hz", c.rate, 10.0, 1000.0);
+  c.status_rate = r.number_in("status_rate_hz", c.status_rate, 1.0, 1000.0);
+  c.nav_timeout = r.number_in("nav_timeout", c.nav_timeout, 0.01, 10.0);
+  c.ref_traj_timeout = r.number_in("ref_traj_timeout", c.ref_traj_timeout, 0.01, 10.0);
+  YamlReader outer = r.child("outer_loop");
+  c.gains.position = read_vec3(outer, "position_gain", c.gains.position);
+  c.gains.velocity = read_vec3(outer, "velocity_gain", c.gains.velocity);
+  c.gains.integral = read_vec3(outer, "integral_gain", c.gains.integral);
+  c.gains.integral_limit = outer.number_in("integral_limit", c.gains.integral_limit, 0.0, 20.0);
+  c.gains.max_horizontal_accel =
+      outer.number_in("max_horizontal_accel", c.gains.max_horizontal_accel, 0.1, 20.0);
+  c.gains.max_vertical_accel =
+      outer.number_in("max_vertical_accel", c.gains.max_vertical_accel, 0.1, 20.0);
+  c.gains.max_tilt = deg2rad(outer.number_in("max_tilt_deg", rad2deg(c.gains.max_tilt), 1.0, 60.0));
+  outer.finish();
+  YamlReader inner = r.child("inner_loop");
+  c.gains.attitude = read_vec3(inner, "attitude_gain", c.gains.attitude);
+  c.gains.rate = read_vec3(inner, "rate_gain", c.gains.rate);
+  c.gains.attitude_integral = read_vec3(inner, "integral_gain", c.gains.attitude_integral);
+  c.gains.attitude_integral_limit =
+      inner.number_in("integral_limit", c.gains.attitude_integral_limit, 0.0, 100.0);
+  inner.finish();
+  YamlReader guidance = r.child("guidance");
+  c.guidance.accel_fraction = guidance.number_in("accel_fraction", c.guidance.accel_fraction, 0.05, 1.0);
+  c.guidance.speed_gain = guidance.number_in("speed_gain", c.guidance.speed_gain, 0.05, 20.0);
+  c.guidance.jerk_fraction = guidance.number_in("jerk_fraction", c.guidance.jerk_fraction, 0.05, 100.0);
+  c.guidance.max_lead = guidance.number_in("max_lead", c.guidance.max_lead, 0.1, 1000.0);
+  c.guidance.stop_speed = guidance.number_in("stop_speed", c.guidance.stop_speed, 0.01, 10.0);
+  guidance.finish();
+  YamlReader sweep = r.child("yaw_sweep");
+  c.sweep.enabled = sweep.boolean("enabled", c.sweep.enabled);
+  c.sweep.frequency = sweep.number_in("frequency_hz", c.sweep.frequency, 0.01, 5.0);
+  c.sweep.total_angle = deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
+  sweep.finish();
+  YamlReader nominal = r.child("nominal_airframe");
+  c.nominal.mass = nominal.number_in("mass", c.nominal.mass, 1.0, 1e4);
+  nominal.finish();
+  r.finish();
+  return c;
+}
+
+std::optional<Reference> sample_ref_traj(const ref_traj_t& traj, Utime now) {
+  const double t = to_seconds(now - traj.t0_utime);
+  const auto& ts = traj.sample_time;
+  if (ts.size() < 2 || t < ts.front() || t > ts.back()) return std::nullopt;
+  const size_t i = std::min<size_t>(
+      ts.size() - 2, std::upper_bound(ts.begin(), ts.end(), t) - ts.begin() - 1);
+  const double f = (t - ts[i]) / (ts[i + 1] - ts[i]);
+  auto lerp = [&](const std::vector<std::vector<double>>& v) {
+    return (1.0 - f) * vec(v[i]) + f * vec(v[i + 1]);
+  };
+  Reference r;
+  r.position = lerp(traj.position);
+  r.velocity = lerp(traj.velocity);
+  r.acceleration = lerp(traj.acceleration);
+  return r;
+}
+
+ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, ControllerConfig config)
+    : node_("controller", lcm, clock),
+      config_(std::move(config)),
+      controller_(config_.nominal, config_.gains),
+      guidance_(config_.guidance) {
+  node_.subscribe<nav_state_t>(
+      channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
+      SubscribeOptions{config_.nav_timeout, 0.5});
+  // A plan is not state: it stays valid however old its stamp is.
+  node_.subscribe<mission_t>(
+      channels::kMission, [this](const mission_t& m) { on_mission(m); }, SubscribeOptions{0.0, 0.0});
+  node_.subscribe<ref_traj_t>(
+      channels::kRefTraj, [this](const ref_traj_t& m) { on_ref_traj(m); },
+      SubscribeOptions{config_.ref_traj_timeout, 0.5});
+  node_.add_timer(1.0 / config_.rate, [this] { control_step(); }, "control");
+  node_.add_timer(1.0 / config_.status_rate, [this] { publish_status(); }, "status");
+}
+
+void ControllerService::on_mission(const mission_t& m) {
+  // The uplink repeats the plan; only a new id is a new plan.
+  if (mission_ && mission_->mission_id == m.mission_id && mission_->name == m.name) return;
+  mission_ = m;
+  mission_pending_ = true;
+  node_.log().info("mission {} '{}': {} waypoints, cruise {:.2f} m/s", m.mission_id, m.name,
+                   m.num_waypoints, m.cruise_speed);
+}
+
+double ControllerService::yaw_reference(const Vec3& leg_direction, double* yaw_rate) {
+  // Face along the path; hold the last heading while hovering.
+  if (std::hypot(leg_direction.x(), leg_direction.y()) > 0.2) {
+    path_yaw_ = std::atan2(leg_direction.y(), leg_direction.x());
+    path_yaw_set_ = true;
+  }
+  double yaw = path_yaw_;
+  *yaw_rate = 0;
+  if (config_.sweep.enabled && mode_ != control_status_t::HOLD) {
+    // Sweep the vertical scanner across the path (paper section 3.1).
+    const double w = 2.0 * kPi * config_.sweep.frequency;
+    const double t = to_seconds(node_.now());
+    yaw += 0.5 * config_.sweep.total_angle * std::sin(w * t);
+    *yaw_rate = 0.5 * config_.sweep.total_angle * w * std::cos(w * t);
+  }
+  return wrap_angle(yaw);
+}
+
+void ControllerService::control_step() {
+  const Utime now = node_.now();
+  const double dt = last_step_ == INT64_MIN ? 1.0 / config_.rate
+                                            : std::clamp(to_seconds(now - last_step_), 1e-4, 0.1);
+  last_step_ = now;
+  actuator_cmd_t cmd;
+  cmd.utime = now;
+
+  const bool nav_fresh = nav_ && now - nav_->utime <= to_utime(config_.nav_timeout);
+  if (!nav_fresh) {
+    if (mode_ != control_status_t::NAV_STALE && nav_)
+      node_.log().warn("navigation lost: commanding level hover");
+    mode_ = control_status_t::NAV_STALE;
+    node_.set_state("degraded");
+    controller_.reset();
+    const auto hover = controller_.hover_command();
+    cmd.collective = hover.collective;
+    cmd.lon_cyclic = hover.lon_cyclic;
+    cmd.lat_cyclic = hover.lat_cyclic;
+    cmd.pedal = hover.pedal;
+    // Without navigation, only command if we ever had it (never fly blind
+    // from the ground).
+    if (nav_) node_.publish(channels::kActuatorCmd, cmd);
+    return;
+  }
+  node_.set_state("running");
+  VehicleEstimate x;
+  x.position = vec(nav_->position);
+  x.velocity = vec(nav_->velocity);
+  x.attitude = Quat(nav_->quaternion[0], nav_->quaternion[1], nav_->quaternion[2],
+                    nav_->quaternion[3]).normalized();
+  x.body_rates = vec(nav_->body_rates);
+  if (!path_yaw_set_) {
+    path_yaw_ = nav_->euler[2];
+    path_yaw_set_ = true;
+  }
+
+  if (mission_pending_) {
+    std::vector<Waypoint> wps;
+    for (const auto& w : mission_->waypoints) wps.push_back({vec(w.position), w.capture_radius});
+    Limits lim{mission_->limits.max_speed, mission_->limits.max_accel,
+               mission_->limits.max_vertical_speed, mission_->limits.min_forward_speed,
+               mission_->limits.clearance, mission_->limits.sensor_range};
+    guidance_.set_mission(wps, mission_->cruise_speed, lim, x.position, x.velocity);
+    mission_pending_ = false;
+  }
+
+  const int8_t previous = mode_;
+  std::optional<Reference> traj_ref;
+  if (ref_traj_ && now - ref_traj_->utime <= to_utime(config_.ref_traj_timeout))
+    traj_ref = sample_ref_traj(*ref_traj_, now);
+
+  Reference ref;
+  Vec3 leg_direction = Vec3::Zero();
+  if (!guidance_.has_mission()) {
+    if (previous != control_status_t::HOLD) hold_position_ = x.position;
+    mode_ = control_status_t::HOLD;
+    ref.position = hold_position_;
+  } else if (traj_ref) {
+    mode_ = control_status_t::TRAJECTORY;
+    ref = *traj_ref;
+    leg_direction = ref.velocity;
+  } else {
+    if (previous == control_status_t::TRAJECTORY) guidance_.resync(x.position, x.velocity);
+    const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
+    active_waypoint_ = g.active_waypoint;
+    ref.position = g.position;
+    ref.velocity = g.velocity;
+    ref.acceleration = g.acceleration;
+    leg_direction = g.leg_direction;
+    mode_ = g.done ? control_status_t::DONE : control_status_t::WAYPOINT;
+  }
+  if (previous == control_status_t::HOLD && mode_ != control_status_t::HOLD) controller_.reset();
+  if (mode_ != previous)
+    node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
+                     static_cast<int>(mode_), to_seconds(now));
+  ref.yaw = yaw_reference(leg_direction, &ref.yaw_rate);
+
+  last_ref_ = ref;
+  last_out_ = controller_.step(ref, x, dt);
+  if (!last_out_.valid) node_.reject("control", "non-finite control output replaced by hover");
+  cmd.collective = last_out_.controls.collective;
+  cmd.lon_cyclic = last_out_.controls.lon_cyclic;
+  cmd.lat_cyclic = last_out_.controls.lat_cyclic;
+  cmd.pedal = last_out_.controls.pedal;
+  node_.publish(channels::kActuatorCmd, cmd);
+}
+
+void ControllerService::publish_status() {
+  // Nothing to report before the first step with navigation.
+  if (last_step_ == INT64_MIN || mode_ == control_status_t::NAV_STALE) return;
+  control_status_t s;
+  s.utime = node_.now();
+  s.mode = mode_;
+  s.mission_id = mission_ ? mission_->mission_id : -1;
+  s.active_waypoint = active_waypoint_;
+  put(s.ref_position, last_ref_.position);
+  put(s.ref_velocity, last_ref_.velocity);
+  put(s.ref_acceleration, last_ref_.acceleration);
+  put(s.commanded_acceleration, last_out_.commanded_accel);
+  put(s.adaptive_output, last_out_.adaptive_accel);
+  const Vec3 pos = nav_ ? vec(nav_->position) : last_ref_.position;
+  put(s.position_error, last_ref_.position - pos);
+  s.yaw_reference = last_ref_.yaw;
+  s.ref_traj_fresh = mode_ == control_status_t::TRAJECTORY;
+  node_.publish(channels::kControlStatus, s);
+}
+
+}  // namespace ofn::control

@@ -1,0 +1,25 @@
+// controller: waypoint guidance, avoidance-trajectory following and the
+// outer/inner model-inversion loops; ACTUATOR_CMD out at the control rate.
+
+#include <CLI/CLI.hpp>
+
+#include "ofn/common/service_main.hpp"
+#include "ofn/controller/controller_service.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"ofn controller: trajectory follower and waypoint guidance"};
+  ofn::CommonOptions options;
+  ofn::add_common_options(app, options);
+  CLI11_PARSE(app, argc, argv);
+
+  return ofn::guarded_main("ofn_controller", [&] {
+    auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")
+                                         : ofn::YamlReader::load_file(options.config);
+    auto config = ofn::control::load_controller_config(reader);
+    auto lcm = ofn::open_lcm(options);
+    auto clock = ofn::make_clock(options.clock);
+    ofn::control::ControllerService service(*lcm, *clock, config);
+    service.node().log().info("clock {}", clock->describe());
+    return ofn::run_nodes(*lcm, *clock, {&service.node()});
+  });
+}

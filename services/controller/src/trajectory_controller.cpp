@@ -1,0 +1,182 @@
+#include "ofn/controller/trajectory_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ofn::control {
+namespace {
+
+bool finite(const vehicle::Controls& c) {
+  return std::isfinite(c.collective) && std::isfinite(c.lon_cyclic) &&
+         std::isfinite(c.lat_cyclic) && std::isfinite(c.pedal);
+}
+
+Vec3 clamp_norm(const Vec3& v, double limit) {
+  const double n = v.norm();
+  return n > limit ? v * (limit / n) : v;
+}
+
+}  // namespace
+
+TrajectoryController::TrajectoryController(vehicle::RotorcraftParams nominal, ControllerGains gains,
+                                           std::unique_ptr<AdaptiveElement> adaptive)
+    : model_(std::move(nominal)),
+      gains_(gains),
+      adaptive_(adaptive ? std::move(adaptive) : std::make_unique<NoAdaptation>()) {
+  const auto trim = vehicle::trim(model_, Vec3::Zero(), 0.0);
+  hover_ = trim.controls;
+  hover_.lon_cyclic = 0;
+  hover_.lat_cyclic = 0;
+  tail_thrust_estimate_ = -model_.params().tail_thrust_per_rad * trim.controls.pedal;
+}
+
+void TrajectoryController::reset() {
+  position_integral_.setZero();
+  attitude_integral_.setZero();
+  adaptive_->reset();
+}
+
+double TrajectoryController::collective_for_thrust(double thrust, const Vec3& air_body) const {
+  // Invert the nominal blade-element/momentum thrust model: first the
+  // induced velocity momentum theory gives for this thrust, then the
+  // collective that produces the thrust at that inflow.
+  const auto& p = model_.params();
+  const double rho_a = p.air_density * p.disk_area();
+  const double horizontal = std::hypot(air_body.x(), air_body.y());
+  double lo = 0.0, hi = 60.0;
+  for (int i = 0; i < 50; ++i) {
+    const double vi = 0.5 * (lo + hi);
+    const double flow = std::max(0.5, std::hypot(horizontal, vi - air_body.z()));
+    (vi - thrust / (2.0 * rho_a * flow) > 0 ? hi : lo) = vi;
+  }
+  const double vi = 0.5 * (lo + hi);
+  const double tip = p.tip_speed();
+  const double mu = horizontal / tip;
+  const double lambda = (vi - air_body.z()) / tip;
+  const double ct = thrust / (rho_a * tip * tip);
+  return (2.0 * ct / (p.lift_slope * p.solidity) + 0.5 * lambda) / (1.0 / 3.0 + 0.5 * mu * mu);
+}
+
+ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEstimate& x, double dt) {
+  const auto& p = model_.params();
+  const auto& g = gains_;
+  ControlOutput out;
+  AdaptiveInputs ad;
+  ad.dt = dt;
+  ad.velocity = x.velocity;
+  ad.body_rates = x.body_rates;
+
+  // ---- Outer loop: translational pseudo-control (world NED) ----
+  ad.position_error = ref.position - x.position;
+  ad.velocity_error = ref.velocity - x.velocity;
+  position_integral_ += ad.position_error * dt;
+  for (int i = 0; i < 3; ++i) {
+    // Anti-windup: the integral's share stays within its limit.
+    if (g.integral[i] > 0)
+      position_integral_[i] = std::clamp(position_integral_[i], -g.integral_limit / g.integral[i],
+                                         g.integral_limit / g.integral[i]);
+  }
+  ad.pseudo_accel = ref.acceleration + g.position.cwiseProduct(ad.position_error) +
+                    g.velocity.cwiseProduct(ad.velocity_error) +
+                    g.integral.cwiseProduct(position_integral_);
+  out.adaptive_accel = adaptive_->outer_output(ad);
+  Vec3 accel = ad.pseudo_accel - out.adaptive_accel;
+  const Vec3 horizontal = clamp_norm(Vec3(accel.x(), accel.y(), 0.0), g.max_horizontal_accel);
+  const double vertical = std::clamp(accel.z(), -g.max_vertical_accel, g.max_vertical_accel);
+  out.saturated = (horizontal - Vec3(accel.x(), accel.y(), 0.0)).norm() > 1e-9 ||
+                  vertical != accel.z();
+  accel = Vec3(horizontal.x(), horizontal.y(), vertical);
+  out.commanded_accel = accel;
+
+  // Invert: the main rotor must supply m (a - g) less the fuselage drag and
+  // the tail rotor's side force (last step's value; it changes slowly).
+  const Mat3 world_from_body = x.attitude.toRotationMatrix();
+  const Vec3 air_body = world_from_body.transpose() * x.velocity;
+  const Vec3 drag_body = -0.5 * p.air_density *
+                         p.drag_area.cwiseProduct(air_body.cwiseAbs()).cwiseProduct(air_body);
+  const Vec3 other_body = drag_body + Vec3(0.0, tail_thrust_estimate_, 0.0);
+  Vec3 force = p.mass * (accel - Vec3(0, 0, kGravity)) - world_from_body * other_body;
+  // Never ask for less than a fraction of hover thrust or a large tilt.
+  if (force.z() > -0.3 * p.mass * kGravity) force.z() = -0.3 * p.mass * kGravity;
+  const double max_horizontal = -force.z() * std::tan(g.max_tilt);
+  const Vec3 fh = clamp_norm(Vec3(force.x(), force.y(), 0.0), max_horizontal);
+  force.x() = fh.x();
+  force.y() = fh.y();
+  out.thrust = force.norm();
+
+  const Vec3 body_z = -force / out.thrust;
+  const Vec3 heading(std::cos(ref.yaw), std::sin(ref.yaw), 0.0);
+  const Vec3 body_y = body_z.cross(heading).normalized();
+  const Vec3 body_x = body_y.cross(body_z);
+  Mat3 r_des;
+  r_des.col(0) = body_x;
+  r_des.col(1) = body_y;
+  r_des.col(2) = body_z;
+  out.attitude_command = Quat(r_des).normalized();
+  out.controls.collective = collective_for_thrust(out.thrust, air_body);
+
+  // ---- Inner loop: attitude pseudo-control (body axes) ----
+  Quat err = x.attitude.conjugate() * out.attitude_command;
+  if (err.w() < 0) err.coeffs() = -err.coeffs();  // shortest rotation
+  ad.attitude_error = 2.0 * err.vec();
+  const Vec3 rate_command = Vec3(0, 0, ref.yaw_rate);
+  ad.rate_error = rate_command - x.body_rates;
+  attitude_integral_ += ad.attitude_error * dt;
+  for (int i = 0; i < 3; ++i)
+    if (g.attitude_integral[i] > 0)
+      attitude_integral_[i] =
+          std::clamp(attitude_integral_[i], -g.attitude_integral_limit / g.attitude_integral[i],
+                     g.attitude_integral_limit / g.attitude_integral[i]);
+  ad.pseudo_angular = g.attitude.cwiseProduct(ad.attitude_error) +
+                      g.rate.cwiseProduct(ad.rate_error) +
+                      g.attitude_integral.cwiseProduct(attitude_integral_);
+  const Vec3 angular = ad.pseudo_angular - adaptive_->inner_output(ad);
+  const Vec3& w = x.body_rates;
+  const Vec3 moment = p.inertia.cwiseProduct(angular) + w.cross(p.inertia.cwiseProduct(w));
+
+  // Rotor moment per radian of disk tilt: thrust offset at the hub plus the
+  // hub spring.
+  const double moment_per_flap = out.thrust * p.hub_height + p.flap_stiffness;
+  const double flap_lat = moment.x() / moment_per_flap;
+  const double flap_lon = -moment.y() / moment_per_flap;
+  // The disk settles at the cyclic command less blow-back, shifted by the
+  // gyroscopic lag under body rates; invert that steady relation.
+  out.controls.lon_cyclic = (flap_lon - p.flap_time_constant * w.y() + p.flap_blowback * air_body.x()) /
+                            p.cyclic_to_flap;
+  out.controls.lat_cyclic = (flap_lat + p.flap_time_constant * w.x() + p.flap_blowback * air_body.y()) /
+                            p.cyclic_to_flap;
+  // Yaw: tail thrust balances main-rotor torque and supplies the moment.
+  vehicle::RotorcraftState probe;
+  probe.attitude = x.attitude;
+  probe.velocity = x.velocity;
+  probe.body_rates = w;
+  probe.actuators.collective = out.controls.collective;
+  probe.induced_velocity = model_.steady_induced_velocity(out.controls.collective, air_body);
+  vehicle::RotorcraftLoads loads;
+  model_.derivative(probe, probe.actuators, &loads);
+  const double tail_thrust = (loads.rotor_torque - moment.z()) / p.tail_arm;
+  tail_thrust_estimate_ = tail_thrust;
+  const double tail_flow = air_body.y() - w.z() * p.tail_arm;
+  out.controls.pedal = -(tail_thrust + p.tail_velocity_damping * tail_flow) / p.tail_thrust_per_rad;
+
+  adaptive_->update(ad);
+
+  // Clamp to the actuator limits the controller knows of.
+  const vehicle::Controls lo = p.min_controls, hi = p.max_controls;
+  vehicle::Controls c = out.controls;
+  c.collective = std::clamp(c.collective, lo.collective, hi.collective);
+  c.lon_cyclic = std::clamp(c.lon_cyclic, lo.lon_cyclic, hi.lon_cyclic);
+  c.lat_cyclic = std::clamp(c.lat_cyclic, lo.lat_cyclic, hi.lat_cyclic);
+  c.pedal = std::clamp(c.pedal, lo.pedal, hi.pedal);
+  if (c.as_array() != out.controls.as_array()) out.saturated = true;
+  out.controls = c;
+  if (!finite(out.controls) || !out.commanded_accel.allFinite()) {
+    out.controls = hover_;
+    out.commanded_accel.setZero();
+    out.valid = false;
+    reset();
+  }
+  return out;
+}
+
+}  // namespace ofn::control

@@ -1,0 +1,131 @@
+#include "ofn/controller/waypoint_guidance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace ofn::control {
+namespace {
+
+double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+}  // namespace
+
+void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, double cruise_speed,
+                                   const Limits& limits, const Vec3& position,
+                                   const Vec3& velocity) {
+  waypoints_ = waypoints;
+  cruise_speed_ = cruise_speed;
+  limits_ = limits;
+  done_ = false;
+  if (waypoints_.empty()) return;
+  int best = 0;
+  if (waypoints_.size() > 1) {
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (size_t i = 1; i < waypoints_.size(); ++i) {
+      const double d = distance_to_segment(position, waypoints_[i - 1].position, waypoints_[i].position);
+      if (d <= best_distance) {  // ties go to the later leg
+        best_distance = d;
+        best = static_cast<int>(i);
+      }
+    }
+  }
+  // Start the leg at the vehicle's projection onto it, so the reference
+  // does not jump.
+  const Vec3 from = best > 0 ? waypoints_[best - 1].position : position;
+  start_leg(from, best, 0.0);
+  resync(position, velocity);
+}
+
+void WaypointGuidance::start_leg(const Vec3& from, int to_index, double speed_along) {
+  active_ = to_index;
+  leg_start_ = from;
+  const Vec3 leg = waypoints_[to_index].position - from;
+  leg_length_ = leg.norm();
+  if (leg_length_ > 1e-6) leg_dir_ = leg / leg_length_;
+  s_ = 0;
+  s_dot_ = std::max(0.0, speed_along);
+  s_ddot_ = 0;
+}
+
+void WaypointGuidance::resync(const Vec3& position, const Vec3& velocity) {
+  if (waypoints_.empty() || active_ < 0) return;
+  s_ = std::clamp((position - leg_start_).dot(leg_dir_), 0.0, leg_length_);
+  s_dot_ = std::clamp(velocity.dot(leg_dir_), 0.0, leg_speed_limit());
+  s_ddot_ = 0;
+}
+
+double WaypointGuidance::leg_speed_limit() const {
+  double v = cruise_speed_;
+  // Keep the climb or descent rate within its own limit.
+  const double vertical = std::abs(leg_dir_.z());
+  if (vertical > 1e-9) v = std::min(v, limits_.max_vertical_speed / vertical);
+  return v;
+}
+
+GuidanceReference WaypointGuidance::update(const Vec3& position, const Vec3& velocity, double dt) {
+  GuidanceReference out;
+  if (waypoints_.empty() || active_ < 0) return out;
+  const double accel = config_.accel_fraction * limits_.max_accel;
+
+  // Leg switching: inside the capture radius of an intermediate waypoint,
+  // or with the reference at its end, fly on from where the reference is.
+  while (!final_leg()) {
+    const Vec3& target = waypoints_[active_].position;
+    if ((position - target).norm() > waypoints_[active_].capture_radius && s_ < leg_length_ - 1e-9)
+      break;
+    const Vec3 ref_point = leg_start_ + leg_dir_ * s_;
+    const Vec3 next = waypoints_[active_ + 1].position - ref_point;
+    // Keep the part of the speed that lies along the new leg.
+    const double carried = next.norm() > 1e-9 ? s_dot_ * std::max(0.0, leg_dir_.dot(next.normalized())) : 0.0;
+    start_leg(ref_point, active_ + 1, carried);
+  }
+
+  const double remaining = leg_length_ - s_;
+  double target_speed = leg_speed_limit();
+  // Rubber band: do not let the reference run away from a vehicle that lags.
+  const double along = (position - leg_start_).dot(leg_dir_);
+  const double lead = s_ - along;
+  if (lead > config_.max_lead)
+    target_speed *= std::clamp(1.0 - (lead - config_.max_lead) / config_.max_lead, 0.0, 1.0);
+
+  // Distance used up while the deceleration ramps in at the jerk limit.
+  const double jerk = config_.jerk_fraction * limits_.max_accel;
+  const double ramp = s_dot_ * accel / (2.0 * jerk);
+  double desired;
+  if (final_leg() && remaining <= 1e-9) {
+    desired = 0;
+    s_dot_ = 0;
+    s_ = leg_length_;
+  } else if (final_leg() && s_dot_ * s_dot_ >= 2.0 * accel * std::max(remaining - ramp, 0.0)) {
+    // Brake to stop at the last waypoint.
+    desired = -std::min(accel, s_dot_ * s_dot_ / (2.0 * std::max(remaining - ramp, 1e-3)));
+  } else {
+    desired = std::clamp(config_.speed_gain * (target_speed - s_dot_), -accel, accel);
+  }
+  // Jerk limit: the acceleration reference never steps.
+  s_ddot_ = std::clamp(desired, s_ddot_ - jerk * dt, s_ddot_ + jerk * dt);
+  s_dot_ = std::max(0.0, s_dot_ + s_ddot_ * dt);
+  if (s_dot_ == 0.0 && s_ddot_ < 0) s_ddot_ = 0;
+  s_ = std::min(leg_length_, s_ + s_dot_ * dt);
+
+  out.position = leg_start_ + leg_dir_ * s_;
+  out.velocity = leg_dir_ * s_dot_;
+  out.acceleration = leg_dir_ * s_ddot_;
+  out.leg_direction = leg_dir_;
+  out.active_waypoint = active_;
+  const Waypoint& last = waypoints_.back();
+  if (final_leg() && s_ >= leg_length_ - 1e-6 &&
+      (position - last.position).norm() <= last.capture_radius &&
+      velocity.norm() <= config_.stop_speed)
+    done_ = true;
+  out.done = done_;
+  return out;
+}
+
+}  // namespace ofn::control

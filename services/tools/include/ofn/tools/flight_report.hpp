@@ -1,0 +1,28 @@
+#pragma once
+// Turns an LCM log of a flight into CSV files per channel, a summary
+// (summary.json and a one-screen text) and, through plot_flight.py, the
+// flight figure. Used by `ofn_flight_report` and by the lockstep runner.
+
+#include <optional>
+#include <string>
+
+#include "ofn/common/scenario.hpp"
+#include "ofn/tools/flight_analysis.hpp"
+
+namespace ofn::report {
+
+struct ReportResult {
+  FlightSummary summary;
+  std::string text;  // one-screen summary for the terminal
+  size_t events = 0;
+  size_t undecodable = 0;
+};
+
+/// Reads `log_path`, writes CSV and summary files into `out_dir` (created if
+/// needed). `scenario`, if given, supplies the timing gates and display
+/// unit; limits come from the logged MISSION. Throws std::runtime_error if
+/// the log cannot be read.
+ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
+                                 const std::optional<Scenario>& scenario);
+
+}  // namespace ofn::report

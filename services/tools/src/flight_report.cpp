@@ -1,0 +1,236 @@
+#include "ofn/tools/flight_report.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "ofn/actuator_cmd_t.hpp"
+#include "ofn/common/channels.hpp"
+#include "ofn/common/clock.hpp"
+#include "ofn/control_status_t.hpp"
+#include "ofn/heartbeat_t.hpp"
+#include "ofn/mission_t.hpp"
+#include "ofn/nav_state_t.hpp"
+
+namespace ofn::report {
+namespace {
+
+Vec3 vec(const double (&a)[3]) { return Vec3(a[0], a[1], a[2]); }
+
+template <class Msg>
+bool decode(const lcm::LogEvent& e, Msg& out) {
+  return out.decode(e.data, 0, e.datalen) == static_cast<int>(e.datalen);
+}
+
+std::ofstream open_csv(const std::filesystem::path& path, const std::string& header) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path.string());
+  f << std::setprecision(10) << header << "\n";
+  return f;
+}
+
+std::string json_number(std::optional<double> v) {
+  if (!v || !std::isfinite(*v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(10) << *v;
+  return s.str();
+}
+
+}  // namespace
+
+ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
+                                 const std::optional<Scenario>& scenario) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) throw std::runtime_error("cannot read LCM log " + log_path);
+  namespace fs = std::filesystem;
+  const fs::path out(out_dir);
+  fs::create_directories(out);
+
+  ReportResult result;
+  std::vector<NavSample> nav;
+  std::vector<StatusSample> status;
+  std::optional<mission_t> mission;
+  std::optional<Utime> t0;
+  auto rel = [&](Utime t) { return to_seconds(t - *t0); };
+
+  auto nav_csv = open_csv(out / "nav_state.csv",
+                          "t,north,east,down,vn,ve,vd,an,ae,ad,roll,pitch,yaw,p,q,r");
+  auto status_csv = open_csv(out / "control_status.csv",
+                             "t,mode,mission_id,active_waypoint,ref_n,ref_e,ref_d,ref_vn,ref_ve,"
+                             "ref_vd,ref_an,ref_ae,ref_ad,cmd_an,cmd_ae,cmd_ad,err_n,err_e,err_d,"
+                             "yaw_ref");
+  auto cmd_csv = open_csv(out / "actuator_cmd.csv", "t,collective,lon_cyclic,lat_cyclic,pedal");
+  auto hb_csv = open_csv(out / "heartbeats.csv",
+                         "t,service,state,received,rejected,late,loop_time_mean,loop_time_max,"
+                         "cpu_fraction");
+  auto row = [](std::ofstream& f, std::initializer_list<Vec3> vs) {
+    for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
+  };
+
+  // Events before the first navigation sample have no time base yet; keep
+  // them until it arrives.
+  std::vector<lcm::LogEvent> held;
+  std::vector<std::vector<uint8_t>> held_data;
+  auto handle = [&](const std::string& channel, const lcm::LogEvent& e) {
+    if (channel == channels::kNavState) {
+      nav_state_t m;
+      if (!decode(e, m)) return false;
+      NavSample s;
+      s.t = rel(m.utime);
+      s.position = vec(m.position);
+      s.velocity = vec(m.velocity);
+      s.acceleration = vec(m.acceleration);
+      s.euler = vec(m.euler);
+      s.body_rates = vec(m.body_rates);
+      nav.push_back(s);
+      nav_csv << s.t;
+      row(nav_csv, {s.position, s.velocity, s.acceleration, s.euler, s.body_rates});
+      nav_csv << "\n";
+    } else if (channel == channels::kControlStatus) {
+      control_status_t m;
+      if (!decode(e, m)) return false;
+      StatusSample s;
+      s.t = rel(m.utime);
+      s.mode = m.mode;
+      s.mission_id = m.mission_id;
+      s.active_waypoint = m.active_waypoint;
+      s.ref_position = vec(m.ref_position);
+      s.ref_velocity = vec(m.ref_velocity);
+      s.ref_acceleration = vec(m.ref_acceleration);
+      s.commanded_accel = vec(m.commanded_acceleration);
+      s.position_error = vec(m.position_error);
+      s.yaw_reference = m.yaw_reference;
+      status.push_back(s);
+      status_csv << s.t << "," << s.mode << "," << s.mission_id << "," << s.active_waypoint;
+      row(status_csv, {s.ref_position, s.ref_velocity, s.ref_acceleration, s.commanded_accel,
+                       s.position_error});
+      status_csv << "," << s.yaw_reference << "\n";
+    } else if (channel == channels::kActuatorCmd) {
+      actuator_cmd_t m;
+      if (!decode(e, m)) return false;
+      cmd_csv << rel(m.utime) << "," << m.collective << "," << m.lon_cyclic << "," << m.lat_cyclic
+              << "," << m.pedal << "\n";
+    } else if (channel == channels::kMission) {
+      mission_t m;
+      if (!decode(e, m)) return false;
+      mission = m;
+    } else if (channel.rfind(channels::kHeartbeatPrefix, 0) == 0) {
+      heartbeat_t m;
+      if (!decode(e, m)) return false;
+      hb_csv << rel(m.utime) << "," << m.service << "," << m.state << "," << m.received << ","
+             << m.rejected << "," << m.late << "," << m.loop_time_mean << "," << m.loop_time_max
+             << "," << m.cpu_fraction << "\n";
+    }
+    return true;
+  };
+
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    ++result.events;
+    if (!t0) {
+      if (e->channel == channels::kNavState) {
+        nav_state_t m;
+        if (decode(*e, m)) t0 = m.utime;
+      }
+      if (!t0) {
+        held.push_back(*e);
+        held_data.emplace_back(static_cast<const uint8_t*>(e->data),
+                               static_cast<const uint8_t*>(e->data) + e->datalen);
+        held.back().data = held_data.back().data();
+        continue;
+      }
+      for (size_t i = 0; i < held.size(); ++i) {
+        held[i].data = held_data[i].data();
+        if (!handle(held[i].channel, held[i])) ++result.undecodable;
+      }
+      held.clear();
+    }
+    if (!handle(e->channel, *e)) ++result.undecodable;
+  }
+  if (nav.empty()) throw std::runtime_error(log_path + ": no NAV_STATE messages in the log");
+
+  Limits limits;
+  if (mission) {
+    limits = {mission->limits.max_speed,         mission->limits.max_accel,
+              mission->limits.max_vertical_speed, mission->limits.min_forward_speed,
+              mission->limits.clearance,          mission->limits.sensor_range};
+    auto wp_csv = open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
+    for (size_t i = 0; i < mission->waypoints.size(); ++i) {
+      const auto& w = mission->waypoints[i];
+      wp_csv << i << "," << w.position[0] << "," << w.position[1] << "," << w.position[2] << ","
+             << w.capture_radius << "\n";
+    }
+  } else {
+    open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
+  }
+  const auto start_gate = scenario ? scenario->start_gate : std::nullopt;
+  const auto finish_gate = scenario ? scenario->finish_gate : std::nullopt;
+  result.summary = analyse_flight(nav, status, limits, start_gate, finish_gate);
+  const FlightSummary& s = result.summary;
+
+  const std::string unit = scenario ? scenario->display_unit : "m";
+  const double k = scenario ? scenario->metres_per_unit : 1.0;
+  const std::string name = scenario ? scenario->name : (mission ? mission->name : "flight");
+
+  std::ofstream json(out / "summary.json");
+  json << std::setprecision(10) << "{\n"
+       << "  \"scenario\": \"" << name << "\",\n"
+       << "  \"log\": \"" << log_path << "\",\n"
+       << "  \"display_unit\": \"" << unit << "\",\n"
+       << "  \"metres_per_unit\": " << k << ",\n"
+       << "  \"limits\": {\"max_speed\": " << limits.max_speed
+       << ", \"max_accel\": " << limits.max_accel
+       << ", \"max_vertical_speed\": " << limits.max_vertical_speed << "},\n"
+       << "  \"gates\": {\"start_x\": " << json_number(start_gate)
+       << ", \"finish_x\": " << json_number(finish_gate) << "},\n"
+       << "  \"gate_start_t\": " << json_number(s.gate_start_time) << ",\n"
+       << "  \"gate_finish_t\": " << json_number(s.gate_finish_time) << ",\n"
+       << "  \"gate_to_gate\": " << json_number(s.gate_to_gate) << ",\n"
+       << "  \"reached_last_waypoint\": " << (s.reached_last_waypoint ? "true" : "false") << ",\n"
+       << "  \"crossed_finish\": " << (s.crossed_finish ? "true" : "false") << ",\n"
+       << "  \"duration\": " << s.duration << ",\n"
+       << "  \"max_speed\": " << s.max_speed << ",\n"
+       << "  \"max_vertical_speed\": " << s.max_vertical_speed << ",\n"
+       << "  \"max_commanded_accel\": " << s.max_commanded_accel << ",\n"
+       << "  \"max_commanded_accel_fraction\": " << s.max_commanded_accel_fraction << ",\n"
+       << "  \"max_pseudo_control\": " << s.max_pseudo_control << ",\n"
+       << "  \"tracking_rms\": " << s.tracking_rms << ",\n"
+       << "  \"tracking_max\": " << s.tracking_max << ",\n"
+       << "  \"obstacles\": []\n"
+       << "}\n";
+
+  std::ostringstream t;
+  t << std::fixed << std::setprecision(2);
+  t << "Flight '" << name << "' (" << result.events << " logged messages, " << s.duration
+    << " s of navigation data)\n";
+  t << "  result            : "
+    << (s.reached_last_waypoint ? "reached the last waypoint" : "did NOT reach the last waypoint");
+  if (finish_gate) t << (s.crossed_finish ? ", crossed the finish gate" : ", did NOT cross the finish gate");
+  t << "\n";
+  if (s.gate_to_gate)
+    t << "  gate-to-gate time : " << *s.gate_to_gate << " s (x = " << *start_gate / k << " -> "
+      << *finish_gate / k << " " << unit << ")\n";
+  else if (start_gate || finish_gate)
+    t << "  gate-to-gate time : n/a (a gate was not crossed)\n";
+  t << "  max speed         : " << s.max_speed / k << " " << unit << "/s (limit "
+    << limits.max_speed / k << ")\n";
+  t << "  max commanded acc : " << s.max_commanded_accel / k << " " << unit << "/s^2 = "
+    << std::setprecision(0) << 100.0 * s.max_commanded_accel_fraction << std::setprecision(2)
+    << " % of the " << limits.max_accel / k << " " << unit << "/s^2 limit\n";
+  t << "  max pseudo-control: " << s.max_pseudo_control / k << " " << unit
+    << "/s^2 (command plus feedback corrections)\n";
+  t << "  tracking error    : RMS " << s.tracking_rms / k << " " << unit << ", max "
+    << s.tracking_max / k << " " << unit << "\n";
+  if (result.undecodable) t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
+  t << "  files             : " << out.string() << "/{nav_state,control_status,actuator_cmd,"
+    << "heartbeats,waypoints}.csv, summary.json\n";
+  result.text = t.str();
+  std::ofstream(out / "summary.txt") << result.text;
+  return result;
+}
+
+}  // namespace ofn::report

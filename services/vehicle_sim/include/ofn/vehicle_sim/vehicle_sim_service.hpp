@@ -1,0 +1,58 @@
+#pragma once
+// Binds the rotorcraft model to the bus: ACTUATOR_CMD in; NAV_STATE and
+// SIM_CLOCK out. Physics runs on a fixed-step timer of the node's clock.
+
+#include <string>
+
+#include "ofn/common/config.hpp"
+#include "ofn/common/node.hpp"
+#include "ofn/common/scenario.hpp"
+#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+
+namespace ofn::vehicle {
+
+struct VehicleSimConfig {
+  double physics_rate = 400.0;   // Hz, fixed integration step
+  double nav_rate = 100.0;       // Hz, NAV_STATE and SIM_CLOCK
+  double command_timeout = 0.5;  // s without ACTUATOR_CMD before the service reports degraded
+  /// Hold the vehicle in trimmed flight at its start state (the clock still
+  /// runs) until the controller reports it is flying the mission, as a
+  /// flight test begins when the autopilot is engaged.
+  bool hold_until_engaged = true;
+  /// Release the hold after this long anyway (s of clock time).
+  double engage_timeout = 10.0;
+  RotorcraftParams params;
+};
+
+/// Reads a vehicle_sim config; unknown fields are errors.
+VehicleSimConfig load_vehicle_sim_config(YamlReader& reader);
+
+class VehicleSimService {
+ public:
+  VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Scenario& scenario,
+                    VehicleSimConfig config, double real_time_factor = 1.0);
+
+  Node& node() { return node_; }
+  const RotorcraftModel& model() const { return model_; }
+  bool released() const { return released_; }
+
+ private:
+  void on_command(const actuator_cmd_t& msg);
+  void on_control_status(const control_status_t& msg);
+  void step_physics();
+  void publish_nav();
+
+  Node node_;
+  VehicleSimConfig config_;
+  double real_time_factor_;
+  RotorcraftModel model_;
+  RotorcraftState start_state_;
+  Controls trim_controls_;
+  Utime state_time_ = INT64_MIN;
+  Utime last_command_time_ = INT64_MIN;
+  Utime hold_started_ = INT64_MIN;
+  bool released_ = false;
+  int64_t steps_ = 0;
+};
+
+}  // namespace ofn::vehicle

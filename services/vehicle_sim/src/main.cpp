@@ -1,0 +1,34 @@
+// vehicle_sim: the airframe, nav system and (later) LIDAR head stand-in.
+// It is the simulation's time master: its clock runs at --real-time-factor
+// times the wall clock and it publishes SIM_CLOCK for everyone else.
+
+#include <CLI/CLI.hpp>
+
+#include "ofn/common/config.hpp"
+#include "ofn/common/scenario.hpp"
+#include "ofn/common/service_main.hpp"
+#include "ofn/vehicle_sim/vehicle_sim_service.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"ofn vehicle_sim: 6-DOF RMAX-class rotorcraft simulation"};
+  ofn::CommonOptions options;
+  std::string scenario_path;
+  double real_time_factor = 1.0;
+  ofn::add_common_options(app, options, /*with_clock=*/false);
+  app.add_option("--scenario", scenario_path, "scenario file (YAML)")->required();
+  app.add_option("--real-time-factor", real_time_factor, "simulation speed, 1 = real time")
+      ->check(CLI::Range(0.01, 1000.0));
+  CLI11_PARSE(app, argc, argv);
+
+  return ofn::guarded_main("ofn_vehicle_sim", [&] {
+    const ofn::Scenario scenario = ofn::load_scenario(scenario_path);
+    auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")
+                                         : ofn::YamlReader::load_file(options.config);
+    auto config = ofn::vehicle::load_vehicle_sim_config(reader);
+    auto lcm = ofn::open_lcm(options);
+    ofn::ScaledWallClock clock(0, real_time_factor);
+    ofn::vehicle::VehicleSimService service(*lcm, clock, scenario, config, real_time_factor);
+    service.node().log().info("scenario '{}', clock {}", scenario.name, clock.describe());
+    return ofn::run_nodes(*lcm, clock, {&service.node()});
+  });
+}
