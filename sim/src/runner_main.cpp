@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "service log level")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.add_flag("--quiet", quiet, "no progress lines");
+  app.failure_message(CLI::FailureMessage::help);
   CLI11_PARSE(app, argc, argv);
 
   return ofn::guarded_main("ofn_sim_runner", [&]() -> int {

@@ -19,6 +19,8 @@ void on_signal(int) { g_stop.store(true); }
 }  // namespace
 
 void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock) {
+  // A bad command line prints the whole usage, not just the complaint.
+  app.failure_message(CLI::FailureMessage::help);
   app.add_option("--config", options.config, "service configuration file (YAML)")
       ->check(CLI::ExistingFile);
   app.add_option("--lcm-url", options.lcm_url,
@@ -58,11 +60,11 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
 
   // A following clock advances on SIM_CLOCK; timers then fire on the
   // message, so each service steps in simulation time.
+  // The first node owns the subscription, so its heartbeat counts bad
+  // SIM_CLOCK messages like any other input.
   auto* follower = dynamic_cast<SimFollowClock*>(&clock);
-  std::unique_ptr<Node> clock_node;
-  if (follower) {
-    clock_node = std::make_unique<Node>("sim_clock", lcm, clock);
-    clock_node->subscribe<sim_clock_t>(
+  if (follower && !nodes.empty()) {
+    nodes.front()->subscribe<sim_clock_t>(
         channels::kSimClock, [follower](const sim_clock_t& m) { follower->update(m.utime); },
         SubscribeOptions{0.0, 0.0});
   }
@@ -84,8 +86,9 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
       std::cerr << "LCM receive failed; stopping\n";
       return 1;
     }
-    // Drain whatever else arrived before running timers again.
-    while (lcm.handleTimeout(0) > 0) {
+    // Drain what else arrived before running timers again, but bounded so
+    // that a flood of messages cannot starve the timers.
+    for (int i = 0; i < 1000 && lcm.handleTimeout(0) > 0; ++i) {
     }
   }
   return 0;

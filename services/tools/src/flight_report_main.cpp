@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "folder for the CSV and summary files")->required();
   app.add_option("--scenario", scenario_path, "scenario file: timing gates and display unit")
       ->check(CLI::ExistingFile);
+  app.failure_message(CLI::FailureMessage::help);
   CLI11_PARSE(app, argc, argv);
   return ofn::guarded_main("ofn_flight_report", [&] {
     std::optional<ofn::Scenario> scenario;

@@ -1,0 +1,122 @@
+// Publishes garbage on every channel of the bus (random bytes, and each
+// message type filled with NaN or with absurd sizes), then listens to the
+// heartbeats and reports each service's rejection counter. Exits 0 when
+// every service named on the command line is still alive and has rejected
+// something.
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include "ofn/actuator_cmd_t.hpp"
+#include "ofn/common/channels.hpp"
+#include "ofn/common/node.hpp"
+#include "ofn/control_status_t.hpp"
+#include "ofn/heartbeat_t.hpp"
+#include "ofn/mission_t.hpp"
+#include "ofn/nav_state_t.hpp"
+#include "ofn/ref_traj_t.hpp"
+#include "ofn/sim_clock_t.hpp"
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string&,
+                  std::map<std::string, ofn::heartbeat_t>* seen) {
+  ofn::heartbeat_t hb;
+  if (hb.decode(rbuf->data, 0, rbuf->data_size) == static_cast<int>(rbuf->data_size))
+    (*seen)[hb.service] = hb;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"publish garbage on every channel and check that services reject it"};
+  std::string url = "udpm://239.255.76.67:7667?ttl=0";
+  std::vector<std::string> services;
+  int rounds = 200;
+  app.add_option("--lcm-url", url);
+  app.add_option("--rounds", rounds, "garbage messages per channel and kind");
+  app.add_option("--expect", services, "services that must stay alive and count rejections")
+      ->required();
+  CLI11_PARSE(app, argc, argv);
+
+  lcm::LCM lcm(url);
+  if (!lcm.good()) return 2;
+  std::map<std::string, ofn::heartbeat_t> seen;
+  lcm.subscribeFunction("HEARTBEAT_.*", &on_heartbeat, &seen);
+
+  namespace ch = ofn::channels;
+  const std::vector<std::string> channels = {
+      ch::kNavState,  ch::kActuatorCmd,  ch::kSimClock, ch::kMission,      ch::kVirtualObstacles,
+      ch::kLidarRaw,  ch::kScanWorld,    ch::kObstacleGrid, ch::kCuboids,  ch::kGlobalPath,
+      ch::kRefTraj,   ch::kSolverStats,  ch::kControlStatus};
+  std::mt19937 rng(42);
+  std::uniform_int_distribution<int> byte(0, 255), length(0, 600);
+
+  ofn::nav_state_t nav{};
+  nav.frame = "NED";
+  for (int i = 0; i < 3; ++i) nav.position[i] = kNaN;
+  nav.quaternion[0] = 1;
+  ofn::actuator_cmd_t cmd{};
+  cmd.collective = kNaN;
+  ofn::sim_clock_t clock{};
+  clock.real_time_factor = kNaN;
+  ofn::mission_t mission{};
+  mission.frame = "NED";
+  mission.cruise_speed = kNaN;
+  ofn::ref_traj_t traj{};
+  traj.frame = "NED";
+  traj.num_samples = 2;
+  traj.sample_time = {0.0, kNaN};
+  traj.position = traj.velocity = traj.acceleration = {{0, 0, 0}, {0, 0, 0}};
+  ofn::control_status_t status{};
+  status.ref_position[0] = kNaN;
+
+  for (int r = 0; r < rounds; ++r) {
+    for (const auto& c : channels) {
+      std::vector<uint8_t> junk(static_cast<size_t>(length(rng)));
+      for (auto& b : junk) b = static_cast<uint8_t>(byte(rng));
+      lcm.publish(c, junk.data(), static_cast<unsigned>(junk.size()));
+    }
+    lcm.publish(ch::kNavState, &nav);
+    lcm.publish(ch::kActuatorCmd, &cmd);
+    lcm.publish(ch::kSimClock, &clock);
+    lcm.publish(ch::kMission, &mission);
+    lcm.publish(ch::kRefTraj, &traj);
+    lcm.publish(ch::kControlStatus, &status);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  }
+  // Heartbeats come once a second of (simulated) time; listen long enough.
+  seen.clear();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(4);
+  while (std::chrono::steady_clock::now() < until) lcm.handleTimeout(100);
+
+  int failures = 0;
+  for (const auto& name : services) {
+    auto it = seen.find(name);
+    if (it == seen.end()) {
+      std::cout << "fuzz: " << name << ": no heartbeat after the flood (dead?)\n";
+      ++failures;
+    } else if (it->second.rejected <= 0) {
+      std::cout << "fuzz: " << name << ": alive but rejected nothing\n";
+      ++failures;
+    } else {
+      std::cout << "fuzz: " << name << ": alive, rejected " << it->second.rejected
+                << " (last: " << it->second.last_reject_reason << ")\n";
+    }
+  }
+  return failures == 0 ? 0 : 1;
+}

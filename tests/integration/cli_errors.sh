@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Bad command lines and files get a clear message and a non-zero exit, never a crash.
+source "$(dirname "$0")/common.sh"
+expect_error() {  # expect_error "pattern" command...
+  local pattern=$1; shift
+  set +e; "$@" > "$WORK/out.txt" 2>&1; local code=$?; set -e
+  [[ $code -ne 0 && $code -lt 128 ]] || { cat "$WORK/out.txt"; fail "'$*' exited $code"; }
+  grep -q -- "$pattern" "$WORK/out.txt" || { cat "$WORK/out.txt"; fail "'$*' did not say '$pattern'"; }
+}
+expect_error "Usage" "$BIN/ofn_controller" --no-such-flag
+expect_error "Usage" "$BIN/ofn_vehicle_sim" --scenario
+expect_error "scenario is required\|--scenario is required" "$BIN/ofn_mission_uplink"
+cat > "$WORK/bad.yaml" <<'YAML'
+name: bad
+units: ft
+start: {position: [0, 0, 100], speed: 5}
+waypoints:
+  - position: [0, 0]
+limits: {max_speed: 10, max_accel: 1.6, max_vertical_speed: 5}
+YAML
+expect_error "bad.yaml: field 'waypoints\[0\].position'" "$BIN/ofn_sim_runner" --scenario "$WORK/bad.yaml"
+sed -i 's/units: ft/units: yards/' "$WORK/bad.yaml"
+expect_error "field 'units': expected 'ft' or 'm'" "$BIN/ofn_mission_uplink" --scenario "$WORK/bad.yaml"
+printf 'outer_loop:\n  position_gian: [1, 1, 1]\n' > "$WORK/ctl.yaml"
+expect_error "ctl.yaml: unknown field 'outer_loop.position_gian'" "$BIN/ofn_controller" --config "$WORK/ctl.yaml"
+printf 'rate_hz: fast\n' > "$WORK/ctl.yaml"
+expect_error "field 'rate_hz': expected a number" "$BIN/ofn_controller" --config "$WORK/ctl.yaml"
+expect_error "File does not exist" "$BIN/ofn_controller" --config "$WORK/missing.yaml"
+printf 'not: [valid' > "$WORK/broken.yaml"
+expect_error "broken.yaml: line" "$BIN/ofn_sim_runner" --scenario "$WORK/broken.yaml"
+expect_error "no NAV_STATE\|cannot read" "$BIN/ofn_flight_report" --log "$WORK/ctl.yaml" --out "$WORK/r"
+pass "bad command lines and files rejected with clear messages"

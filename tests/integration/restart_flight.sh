@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Killing the controller mid-flight: the launcher restarts it, the restarted
+# controller picks up the mission where the vehicle is, and the flight
+# still completes.
+source "$(dirname "$0")/common.sh"
+/usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/open.yaml" \
+  --bin "$BIN" --rtf 4 --log-dir "$WORK/run" --timeout 150 --no-pin > "$WORK/launch.txt" 2>&1 &
+launcher=$!
+# Wait until the vehicle is well into the flight (about 20 s of flight time).
+sleep 6
+pkill -KILL -f "$BIN/ofn_controller" || fail "no controller process to kill"
+echo "killed the controller"
+wait $launcher || { tail -40 "$WORK/launch.txt"; fail "launcher exit code $?"; }
+grep -qi "controller exited" "$WORK/launch.txt" || fail "launcher did not notice the controller exit"
+grep -qi "restarting" "$WORK/launch.txt" || fail "launcher did not restart the controller"
+log=$(cat "$WORK/run/latest_log")
+"$BIN/ofn_flight_report" --log "$log" --scenario "$REPO/sim/scenarios/open.yaml" \
+  --out "$WORK/report" > "$WORK/report.txt"
+cat "$WORK/report.txt"
+grep -q "reached the last waypoint, crossed the finish gate" "$WORK/report.txt" ||
+  fail "the flight did not complete after the restart"
+pass "controller restarted by the launcher; flight completed"
