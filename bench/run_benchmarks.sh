@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# make bench: core step costs (Google Benchmark) and the lockstep real-time
+# factor of the no-obstacle course. Writes results/bench/ and prints a table
+# ready for the README.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-build}
+[[ "$build" = /* ]] || build="$repo/$build"
+out="$repo/results/bench"
+mkdir -p "$out"
+
+echo "== core step costs (Google Benchmark) =="
+"$build/bin/ofn_benchmarks" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+  --benchmark_out="$out/core.json" --benchmark_out_format=json | tee "$out/core.txt"
+
+echo
+echo "== lockstep runner, open course (5 runs) =="
+rtf_list=()
+for i in 1 2 3 4 5; do
+  line=$("$build/bin/ofn_sim_runner" --scenario "$repo/sim/scenarios/open.yaml" \
+           --config-dir "$repo/config" --quiet | grep '^lockstep:')
+  echo "$line"
+  rtf_list+=("$(sed -E 's/.*\(([0-9.]+)x real time\).*/\1/' <<< "$line")")
+done
+sorted=$(printf '%s\n' "${rtf_list[@]}" | sort -n)
+median=$(sed -n 3p <<< "$sorted")
+{
+  echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+  echo "lockstep real-time factor, open course (median of 5): ${median}x (goal >= 50x)"
+} | tee "$out/lockstep.txt"
