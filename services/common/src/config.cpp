@@ -1,5 +1,6 @@
 #include "ofn/common/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -175,6 +176,22 @@ void YamlReader::finish() const {
     s << ")";
   }
   throw ConfigError(s.str());
+}
+
+}  // namespace ofn
+
+namespace ofn {
+
+void YamlReader::expect_only(const std::vector<std::string>& known) const {
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.Scalar();
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::ostringstream s;
+    s << file_ << ": unknown field '" << field(key) << "' (known here:";
+    for (const auto& k : known) s << " " << k;
+    s << ")";
+    throw ConfigError(s.str());
+  }
 }
 
 }  // namespace ofn

@@ -6,6 +6,8 @@ namespace ofn {
 
 Scenario load_scenario(const std::string& path) {
   YamlReader root = YamlReader::load_file(path);
+  root.expect_only({"name", "description", "units", "start", "waypoints", "capture_radius",
+                    "cruise_speed", "limits", "gates", "environment", "max_time"});
   Scenario s;
   s.file = path;
   s.name = root.text("name");

@@ -1,6 +1,7 @@
 #include "ofn/common/service_main.hpp"
 
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstdlib>
 #include <iostream>
@@ -83,6 +84,9 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
       wait_ms = static_cast<int>(std::clamp(wait * 1000.0, 0.0, 50.0));
     }
     if (lcm.handleTimeout(wait_ms) < 0) {
+      // A stop signal interrupts the wait; that is a clean stop.
+      if (g_stop.load()) break;
+      if (errno == EINTR) continue;
       std::cerr << "LCM receive failed; stopping\n";
       return 1;
     }

@@ -32,6 +32,7 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.gains.velocity = read_vec3(outer, "velocity_gain", c.gains.velocity);
   c.gains.integral = read_vec3(outer, "integral_gain", c.gains.integral);
   c.gains.integral_limit = outer.number_in("integral_limit", c.gains.integral_limit, 0.0, 20.0);
+  c.gains.integral_band = outer.number_in("integral_band", c.gains.integral_band, 0.0, 1000.0);
   c.gains.max_horizontal_accel =
       outer.number_in("max_horizontal_accel", c.gains.max_horizontal_accel, 0.1, 20.0);
   c.gains.max_vertical_accel =
@@ -71,7 +72,7 @@ std::optional<Reference> sample_ref_traj(const ref_traj_t& traj, Utime now) {
   const size_t i = std::min<size_t>(
       ts.size() - 2, std::upper_bound(ts.begin(), ts.end(), t) - ts.begin() - 1);
   const double f = (t - ts[i]) / (ts[i + 1] - ts[i]);
-  auto lerp = [&](const std::vector<std::vector<double>>& v) {
+  auto lerp = [&](const std::vector<std::vector<double>>& v) -> Vec3 {
     return (1.0 - f) * vec(v[i]) + f * vec(v[i + 1]);
   };
   Reference r;

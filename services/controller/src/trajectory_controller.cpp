@@ -27,12 +27,14 @@ TrajectoryController::TrajectoryController(vehicle::RotorcraftParams nominal, Co
   hover_ = trim.controls;
   hover_.lon_cyclic = 0;
   hover_.lat_cyclic = 0;
-  tail_thrust_estimate_ = -model_.params().tail_thrust_per_rad * trim.controls.pedal;
+  hover_tail_thrust_ = -model_.params().tail_thrust_per_rad * trim.controls.pedal;
+  tail_thrust_estimate_ = hover_tail_thrust_;
 }
 
 void TrajectoryController::reset() {
   position_integral_.setZero();
   attitude_integral_.setZero();
+  tail_thrust_estimate_ = hover_tail_thrust_;
   adaptive_->reset();
 }
 
@@ -69,9 +71,11 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   // ---- Outer loop: translational pseudo-control (world NED) ----
   ad.position_error = ref.position - x.position;
   ad.velocity_error = ref.velocity - x.velocity;
-  position_integral_ += ad.position_error * dt;
   for (int i = 0; i < 3; ++i) {
-    // Anti-windup: the integral's share stays within its limit.
+    // Anti-windup: integrate only near the reference (large errors are the
+    // proportional term's job, and winding up on them overshoots), and keep
+    // the integral's share within its limit.
+    if (std::abs(ad.position_error[i]) < g.integral_band) position_integral_[i] += ad.position_error[i] * dt;
     if (g.integral[i] > 0)
       position_integral_[i] = std::clamp(position_integral_[i], -g.integral_limit / g.integral[i],
                                          g.integral_limit / g.integral[i]);
@@ -155,7 +159,8 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   vehicle::RotorcraftLoads loads;
   model_.derivative(probe, probe.actuators, &loads);
   const double tail_thrust = (loads.rotor_torque - moment.z()) / p.tail_arm;
-  tail_thrust_estimate_ = tail_thrust;
+  // Carried to the next step; one bad input must not poison the ones after.
+  if (std::isfinite(tail_thrust)) tail_thrust_estimate_ = tail_thrust;
   const double tail_flow = air_body.y() - w.z() * p.tail_arm;
   out.controls.pedal = -(tail_thrust + p.tail_velocity_damping * tail_flow) / p.tail_thrust_per_rad;
 

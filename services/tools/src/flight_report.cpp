@@ -78,7 +78,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   std::vector<std::vector<uint8_t>> held_data;
   auto handle = [&](const std::string& channel, const lcm::LogEvent& e) {
     if (channel == channels::kNavState) {
-      nav_state_t m;
+      nav_state_t m{};
       if (!decode(e, m)) return false;
       NavSample s;
       s.t = rel(m.utime);
@@ -92,7 +92,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       row(nav_csv, {s.position, s.velocity, s.acceleration, s.euler, s.body_rates});
       nav_csv << "\n";
     } else if (channel == channels::kControlStatus) {
-      control_status_t m;
+      control_status_t m{};
       if (!decode(e, m)) return false;
       StatusSample s;
       s.t = rel(m.utime);
@@ -111,16 +111,16 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
                        s.position_error});
       status_csv << "," << s.yaw_reference << "\n";
     } else if (channel == channels::kActuatorCmd) {
-      actuator_cmd_t m;
+      actuator_cmd_t m{};
       if (!decode(e, m)) return false;
       cmd_csv << rel(m.utime) << "," << m.collective << "," << m.lon_cyclic << "," << m.lat_cyclic
               << "," << m.pedal << "\n";
     } else if (channel == channels::kMission) {
-      mission_t m;
+      mission_t m{};
       if (!decode(e, m)) return false;
       mission = m;
     } else if (channel.rfind(channels::kHeartbeatPrefix, 0) == 0) {
-      heartbeat_t m;
+      heartbeat_t m{};
       if (!decode(e, m)) return false;
       hb_csv << rel(m.utime) << "," << m.service << "," << m.state << "," << m.received << ","
              << m.rejected << "," << m.late << "," << m.loop_time_mean << "," << m.loop_time_max
@@ -133,7 +133,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     ++result.events;
     if (!t0) {
       if (e->channel == channels::kNavState) {
-        nav_state_t m;
+        nav_state_t m{};
         if (decode(*e, m)) t0 = m.utime;
       }
       if (!t0) {

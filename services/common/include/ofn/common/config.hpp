@@ -48,6 +48,10 @@ class YamlReader {
 
   /// Throws ConfigError naming any field that was never read.
   void finish() const;
+  /// Throws ConfigError naming the first field not in `known`; call it
+  /// before reading, so that a misspelt field is named rather than the
+  /// required one it was meant to be.
+  void expect_only(const std::vector<std::string>& known) const;
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
   const std::string& file() const { return file_; }

@@ -61,7 +61,7 @@ class ControllerService {
   std::optional<mission_t> mission_;
   bool mission_pending_ = false;
   std::optional<ref_traj_t> ref_traj_;
-  int8_t mode_ = control_status_t::HOLD;
+  int8_t mode_ = control_status_t::NAV_STALE;  // until the first navigation arrives
   Vec3 hold_position_ = Vec3::Zero();
   double path_yaw_ = 0;
   bool path_yaw_set_ = false;

@@ -37,6 +37,7 @@ struct ControllerGains {
   Vec3 velocity = Vec3(1.44, 1.44, 1.8);      // 1/s
   Vec3 integral = Vec3(0.04, 0.04, 0.1);      // 1/s^3
   double integral_limit = 1.0;                // m/s^2, largest integral share
+  double integral_band = 1.0;                 // m, integrate only errors smaller than this
   double max_horizontal_accel = 3.0;          // m/s^2, pseudo-control bound
   double max_vertical_accel = 3.0;            // m/s^2
   double max_tilt = deg2rad(25.0);            // rad
@@ -111,6 +112,7 @@ class TrajectoryController {
   Vec3 position_integral_ = Vec3::Zero();
   Vec3 attitude_integral_ = Vec3::Zero();
   double tail_thrust_estimate_ = 0;  // N, side force of the tail rotor
+  double hover_tail_thrust_ = 0;     // N, its hover value, after a reset
 };
 
 }  // namespace ofn::control
