@@ -1,0 +1,301 @@
+// The trajectory controller in closed loop with the rotorcraft model, and its
+// behaviour on bad inputs.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "ofn/controller/trajectory_controller.hpp"
+#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+
+namespace ofn::control {
+namespace {
+
+using vehicle::Controls;
+using vehicle::RotorcraftModel;
+using vehicle::RotorcraftParams;
+
+constexpr double kControlDt = 0.01;    // 100 Hz control loop
+constexpr int kPhysicsPerControl = 4;  // 400 Hz physics
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+VehicleEstimate estimate_of(const vehicle::RotorcraftState& s) {
+  VehicleEstimate x;
+  x.position = s.position;
+  x.velocity = s.velocity;
+  x.attitude = s.attitude;
+  x.body_rates = s.body_rates;
+  return x;
+}
+
+bool within_limits(const Controls& c, const RotorcraftParams& p) {
+  const auto v = c.as_array(), lo = p.min_controls.as_array(), hi = p.max_controls.as_array();
+  for (int i = 0; i < 4; ++i)
+    if (!std::isfinite(v[i]) || v[i] < lo[i] || v[i] > hi[i]) return false;
+  return true;
+}
+
+/// Vehicle (nominal parameters) starting in hover trim at the origin, flown
+/// by the controller with the same nominal parameters.
+class ClosedLoop {
+ public:
+  ClosedLoop() : controller_(RotorcraftParams{}) {
+    const auto t = vehicle::trim(model_, Vec3::Zero(), 0.0);
+    EXPECT_TRUE(t.converged);
+    model_.set_state(t.state);
+    model_.set_command(t.controls);
+  }
+
+  /// One control period: controller step, then four physics steps.
+  ControlOutput step(const Reference& ref) {
+    const ControlOutput out = controller_.step(ref, estimate_of(model_.state()), kControlDt);
+    model_.set_command(out.controls);
+    for (int i = 0; i < kPhysicsPerControl; ++i) model_.step(kControlDt / kPhysicsPerControl);
+    return out;
+  }
+
+  const vehicle::RotorcraftState& state() const { return model_.state(); }
+  const RotorcraftModel& model() const { return model_; }
+
+ private:
+  RotorcraftModel model_;
+  TrajectoryController controller_;
+};
+
+/// Outcome of a reference step along one world axis.
+struct StepResponse {
+  double overshoot = 0;        // m beyond the target, along the step
+  double settling_time = 1e9;  // s after which |error| stays within the band
+  double final_error = 0;      // m
+  double max_off_axis = 0;     // m, largest deviation on the other axes
+  bool all_valid = true;
+  bool all_within_limits = true;
+};
+
+StepResponse fly_step(int axis, double size, double band, double duration) {
+  ClosedLoop loop;
+  Reference ref;
+  ref.position[axis] = size;
+  StepResponse r;
+  const int steps = static_cast<int>(std::lround(duration / kControlDt));
+  double last_outside = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    const ControlOutput out = loop.step(ref);
+    r.all_valid = r.all_valid && out.valid;
+    r.all_within_limits = r.all_within_limits && within_limits(out.controls, loop.model().params());
+    const double t = (i + 1) * kControlDt;
+    const Vec3& pos = loop.state().position;
+    const double along = pos[axis] * (size > 0 ? 1.0 : -1.0);
+    r.overshoot = std::max(r.overshoot, along - std::abs(size));
+    const double error = std::abs(pos[axis] - size);
+    if (error > band) last_outside = t;
+    for (int k = 0; k < 3; ++k)
+      if (k != axis) r.max_off_axis = std::max(r.max_off_axis, std::abs(pos[k]));
+    r.final_error = error;
+  }
+  r.settling_time = last_outside;
+  return r;
+}
+
+TEST(TrajectoryController, HoldsHoverAtOriginFor20s) {
+  ClosedLoop loop;
+  const Reference ref;  // origin, level, facing north
+  for (int i = 0; i < 2000; ++i) {
+    const ControlOutput out = loop.step(ref);
+    ASSERT_TRUE(out.valid) << "step " << i;
+  }
+  EXPECT_LT(loop.state().position.norm(), 0.1);
+  EXPECT_LT(loop.state().velocity.norm(), 0.1);
+  EXPECT_LT(std::abs(euler_from_quat(loop.state().attitude).z()), deg2rad(2.0));
+}
+
+// Stated performance of the outer loop for a 5 m horizontal position step
+// from hover (no feed-forward): the error falls into and stays within 10 %
+// of the step (0.5 m) within 15 s, and overshoot stays below 30 % (1.5 m).
+TEST(TrajectoryController, NorthStepSettlesWithin15sWithOvershootBelow30Percent) {
+  const StepResponse r = fly_step(0, 5.0, 0.5, 25.0);
+  EXPECT_TRUE(r.all_valid);
+  EXPECT_TRUE(r.all_within_limits);
+  EXPECT_LT(r.settling_time, 15.0);
+  EXPECT_LT(r.overshoot, 1.5);
+  EXPECT_LT(r.final_error, 0.5);
+  EXPECT_LT(r.max_off_axis, 1.0);  // the step stays on its axis
+}
+
+TEST(TrajectoryController, EastStepSettlesWithin15sWithOvershootBelow30Percent) {
+  const StepResponse r = fly_step(1, 5.0, 0.5, 25.0);
+  EXPECT_TRUE(r.all_valid);
+  EXPECT_TRUE(r.all_within_limits);
+  EXPECT_LT(r.settling_time, 15.0);
+  EXPECT_LT(r.overshoot, 1.5);
+  EXPECT_LT(r.final_error, 0.5);
+  EXPECT_LT(r.max_off_axis, 1.0);
+}
+
+TEST(TrajectoryController, SouthWestStepsAreSymmetric) {
+  const StepResponse south = fly_step(0, -5.0, 0.5, 25.0);
+  EXPECT_LT(south.settling_time, 15.0);
+  EXPECT_LT(south.overshoot, 1.5);
+  const StepResponse west = fly_step(1, -5.0, 0.5, 25.0);
+  EXPECT_LT(west.settling_time, 15.0);
+  EXPECT_LT(west.overshoot, 1.5);
+}
+
+// Stated performance for a 3 m climb step (reference down = -3 m): overshoot
+// below 30 % (0.9 m), and settled within 10 % (0.3 m) of the target within
+// 10 s.
+TEST(TrajectoryController, ClimbStepOvershootBelow30Percent) {
+  const StepResponse r = fly_step(2, -3.0, 0.3, 20.0);
+  EXPECT_TRUE(r.all_valid);
+  EXPECT_TRUE(r.all_within_limits);
+  EXPECT_LT(r.overshoot, 0.9);
+  EXPECT_LT(r.final_error, 0.3);
+  EXPECT_LT(r.max_off_axis, 1.0);
+}
+
+TEST(TrajectoryController, ClimbStepSettlesWithin10s) {
+  const StepResponse r = fly_step(2, -3.0, 0.3, 20.0);
+  EXPECT_LT(r.settling_time, 10.0);
+}
+
+TEST(TrajectoryController, FollowsAConstantVelocityReferenceWithFeedForward) {
+  ClosedLoop loop;
+  // Ramp the reference up to 3 m/s north at 0.5 m/s^2, then cruise.
+  Reference ref;
+  double s = 0, v = 0;
+  double max_error_cruise = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const double a = v < 3.0 ? 0.5 : 0.0;
+    v = std::min(3.0, v + a * kControlDt);
+    s += v * kControlDt;
+    ref.position = Vec3(s, 0, 0);
+    ref.velocity = Vec3(v, 0, 0);
+    ref.acceleration = Vec3(a, 0, 0);
+    ASSERT_TRUE(loop.step(ref).valid);
+    if (i > 2000)
+      max_error_cruise = std::max(max_error_cruise, (ref.position - loop.state().position).norm());
+  }
+  EXPECT_LT(max_error_cruise, 1.0);
+  EXPECT_NEAR(loop.state().velocity.x(), 3.0, 0.2);
+}
+
+TEST(TrajectoryController, NaNPositionGivesSafeFiniteControls) {
+  TrajectoryController controller{RotorcraftParams{}};
+  const RotorcraftParams p;
+  VehicleEstimate x;
+  x.position = Vec3(kNaN, 0, 0);
+  const ControlOutput out = controller.step(Reference{}, x, kControlDt);
+  EXPECT_FALSE(out.valid);
+  EXPECT_TRUE(within_limits(out.controls, p));
+  EXPECT_TRUE(out.commanded_accel.allFinite());
+}
+
+TEST(TrajectoryController, InfiniteReferenceGivesSafeFiniteControls) {
+  TrajectoryController controller{RotorcraftParams{}};
+  const RotorcraftParams p;
+  Reference ref;
+  ref.position = Vec3(kInf, 0, 0);
+  const ControlOutput out = controller.step(ref, VehicleEstimate{}, kControlDt);
+  // Either replaced by the safe hover command, or a finite, limited command.
+  EXPECT_TRUE(within_limits(out.controls, p));
+  EXPECT_TRUE(out.commanded_accel.allFinite());
+  if (!out.valid) {
+    EXPECT_EQ(out.controls.as_array(), controller.hover_command().as_array());
+  }
+}
+
+TEST(TrajectoryController, GarbageInputsNeverGiveNonFiniteOrOutOfLimitControls) {
+  const RotorcraftParams p;
+  struct Case {
+    const char* what;
+    Reference ref;
+    VehicleEstimate x;
+  };
+  std::vector<Case> cases;
+  auto add = [&](const char* what, auto modify) {
+    Case c{what, {}, {}};
+    modify(c.ref, c.x);
+    cases.push_back(c);
+  };
+  add("NaN position", [](Reference&, VehicleEstimate& x) { x.position.y() = kNaN; });
+  add("inf velocity", [](Reference&, VehicleEstimate& x) { x.velocity.x() = kInf; });
+  add("NaN attitude",
+      [](Reference&, VehicleEstimate& x) { x.attitude = Quat(kNaN, kNaN, kNaN, kNaN); });
+  add("NaN body rates", [](Reference&, VehicleEstimate& x) { x.body_rates.z() = kNaN; });
+  add("inf reference position", [](Reference& r, VehicleEstimate&) { r.position.z() = -kInf; });
+  add("NaN reference velocity", [](Reference& r, VehicleEstimate&) { r.velocity.x() = kNaN; });
+  add("inf reference acceleration",
+      [](Reference& r, VehicleEstimate&) { r.acceleration.y() = kInf; });
+  add("NaN yaw", [](Reference& r, VehicleEstimate&) { r.yaw = kNaN; });
+  add("inf yaw rate", [](Reference& r, VehicleEstimate&) { r.yaw_rate = kInf; });
+  for (const auto& c : cases) {
+    TrajectoryController controller{RotorcraftParams{}};
+    const ControlOutput out = controller.step(c.ref, c.x, kControlDt);
+    EXPECT_TRUE(within_limits(out.controls, p)) << c.what;
+    EXPECT_TRUE(out.commanded_accel.allFinite()) << c.what;
+    if (!out.valid) {
+      // The safe command is the level hover.
+      EXPECT_EQ(out.controls.as_array(), controller.hover_command().as_array()) << c.what;
+    }
+  }
+}
+
+TEST(TrajectoryController, RecoversAfterOneGarbageInput) {
+  // One corrupt estimate must not poison the controller: good estimates
+  // afterwards give valid commands again.
+  for (const VehicleEstimate& bad : [] {
+         VehicleEstimate nan_position, nan_rates;
+         nan_position.position = Vec3(kNaN, kNaN, kNaN);
+         nan_rates.body_rates = Vec3(0, 0, kNaN);
+         return std::vector<VehicleEstimate>{nan_position, nan_rates};
+       }()) {
+    TrajectoryController controller{RotorcraftParams{}};
+    EXPECT_FALSE(controller.step(Reference{}, bad, kControlDt).valid);
+    int valid = 0;
+    for (int i = 0; i < 100; ++i)
+      valid += controller.step(Reference{}, VehicleEstimate{}, kControlDt).valid ? 1 : 0;
+    EXPECT_GE(valid, 99) << "good steps after one bad one";
+  }
+}
+
+TEST(TrajectoryController, HugePositionErrorStaysWithinLimits) {
+  const RotorcraftParams p;
+  ControllerGains g;
+  for (const Vec3& error : {Vec3(1000, 0, 0), Vec3(0, -1000, 0), Vec3(0, 0, 1000),
+                            Vec3(0, 0, -1000), Vec3(700, 700, -700)}) {
+    ClosedLoop loop;
+    Reference ref;
+    ref.position = error;
+    for (int i = 0; i < 300; ++i) {
+      const ControlOutput out = loop.step(ref);
+      ASSERT_TRUE(out.valid) << error.transpose() << " step " << i;
+      ASSERT_TRUE(within_limits(out.controls, p)) << error.transpose() << " step " << i;
+      // The pseudo-control stays within its bounds.
+      ASSERT_LE(std::hypot(out.commanded_accel.x(), out.commanded_accel.y()),
+                g.max_horizontal_accel + 1e-9);
+      ASSERT_LE(std::abs(out.commanded_accel.z()), g.max_vertical_accel + 1e-9);
+      EXPECT_TRUE(out.saturated);
+    }
+    // And the vehicle stays upright while it chases the far reference.
+    const Vec3 e = euler_from_quat(loop.state().attitude);
+    EXPECT_LT(std::abs(e.x()), deg2rad(40)) << error.transpose();
+    EXPECT_LT(std::abs(e.y()), deg2rad(40)) << error.transpose();
+  }
+}
+
+TEST(TrajectoryController, HoverCommandIsLevelTrim) {
+  const TrajectoryController controller{RotorcraftParams{}};
+  const RotorcraftModel model;
+  const auto t = vehicle::trim(model, Vec3::Zero(), 0.0);
+  EXPECT_DOUBLE_EQ(controller.hover_command().collective, t.controls.collective);
+  EXPECT_DOUBLE_EQ(controller.hover_command().pedal, t.controls.pedal);
+  EXPECT_EQ(controller.hover_command().lon_cyclic, 0.0);
+  EXPECT_EQ(controller.hover_command().lat_cyclic, 0.0);
+}
+
+}  // namespace
+}  // namespace ofn::control

@@ -1,0 +1,293 @@
+// The services together on the deterministic lockstep bus: a whole flight
+// of the open course, the controller on its own, and REF_TRAJ sampling.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ofn/actuator_cmd_t.hpp"
+#include "ofn/common/channels.hpp"
+#include "ofn/common/config.hpp"
+#include "ofn/common/logging.hpp"
+#include "ofn/common/scenario.hpp"
+#include "ofn/control_status_t.hpp"
+#include "ofn/controller/controller_service.hpp"
+#include "ofn/mission_uplink/mission_uplink_service.hpp"
+#include "ofn/sim/lockstep.hpp"
+#include "ofn/vehicle_sim/vehicle_sim_service.hpp"
+
+namespace ofn {
+namespace {
+
+const std::string kOpenScenario = std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml";
+
+vehicle::VehicleSimConfig default_sim_config() {
+  auto reader = YamlReader::empty("(defaults)");
+  return vehicle::load_vehicle_sim_config(reader);
+}
+
+control::ControllerConfig default_controller_config() {
+  auto reader = YamlReader::empty("(defaults)");
+  return control::load_controller_config(reader);
+}
+
+struct FlightResult {
+  bool arrived = false;
+  Vec3 final_position = Vec3::Zero();
+  double time = 0;
+  int64_t messages = 0;
+  int64_t controller_rejected = 0;
+  int64_t sim_rejected = 0;
+  std::vector<int8_t> modes;  // distinct controller modes in order
+};
+
+FlightResult fly_open_course(const Scenario& scenario) {
+  sim::Lockstep lockstep;
+  vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), scenario,
+                                     default_sim_config());
+  uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), kOpenScenario);
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  lockstep.add(vehicle.node());
+  lockstep.add(uplink.node());
+  lockstep.add(controller.node());
+  FlightResult r;
+  r.arrived = lockstep.run(to_utime(150.0), [&] {
+    if (r.modes.empty() || r.modes.back() != controller.mode())
+      r.modes.push_back(controller.mode());
+    return controller.mode() == control_status_t::DONE;
+  });
+  r.final_position = vehicle.model().state().position;
+  r.time = to_seconds(lockstep.clock().now());
+  r.messages = lockstep.messages();
+  r.controller_rejected = controller.node().counters().rejected;
+  r.sim_rejected = vehicle.node().counters().rejected;
+  return r;
+}
+
+class LockstepServices : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { set_log_level("error"); }
+  static void TearDownTestSuite() { set_log_level("info"); }
+};
+
+TEST_F(LockstepServices, OpenCourseFlightArrivesAtTheLastWaypoint) {
+  const Scenario scenario = load_scenario(kOpenScenario);
+  const FlightResult r = fly_open_course(scenario);
+  ASSERT_TRUE(r.arrived) << "not DONE after " << r.time << " s; at "
+                         << r.final_position.transpose();
+  const Waypoint& last = scenario.waypoints.back();
+  EXPECT_LE((r.final_position - last.position).norm(), last.capture_radius)
+      << r.final_position.transpose();
+  // 183 m at 3 m/s: it took about a minute, not the whole allowance.
+  EXPECT_GT(r.time, 183.0 / scenario.limits.max_speed);
+  EXPECT_LT(r.time, 120.0);
+  // Flew the waypoints and then reported arrival.
+  ASSERT_FALSE(r.modes.empty());
+  EXPECT_EQ(r.modes.back(), control_status_t::DONE);
+  EXPECT_NE(std::find(r.modes.begin(), r.modes.end(), control_status_t::WAYPOINT), r.modes.end());
+  // Nobody rejected anything on a clean run.
+  EXPECT_EQ(r.controller_rejected, 0);
+  EXPECT_EQ(r.sim_rejected, 0);
+}
+
+TEST_F(LockstepServices, SameScenarioGivesTheSameFlightBitForBit) {
+  const Scenario scenario = load_scenario(kOpenScenario);
+  const FlightResult a = fly_open_course(scenario);
+  const FlightResult b = fly_open_course(scenario);
+  EXPECT_EQ(a.arrived, b.arrived);
+  EXPECT_EQ(a.time, b.time);
+  EXPECT_EQ(a.messages, b.messages);
+  EXPECT_EQ(a.final_position.x(), b.final_position.x());
+  EXPECT_EQ(a.final_position.y(), b.final_position.y());
+  EXPECT_EQ(a.final_position.z(), b.final_position.z());
+}
+
+/// Publishes a fixed navigation state at 100 Hz on the lockstep clock.
+class NavFeeder {
+ public:
+  NavFeeder(sim::Lockstep& lockstep, Vec3 position)
+      : node_("nav_feeder", lockstep.lcm(), lockstep.clock()), position_(position) {
+    node_.add_timer(
+        0.01, [this] { publish(); }, "nav");
+  }
+  Node& node() { return node_; }
+  bool enabled = true;
+
+ private:
+  void publish() {
+    if (!enabled) return;
+    nav_state_t m{};
+    m.utime = node_.now();
+    m.frame = "NED";
+    for (int i = 0; i < 3; ++i) m.position[i] = position_[i];
+    m.quaternion[0] = 1.0;
+    node_.publish(channels::kNavState, m);
+  }
+  Node node_;
+  Vec3 position_;
+};
+
+/// Records the controller's outputs.
+class BusRecorder {
+ public:
+  explicit BusRecorder(sim::Lockstep& lockstep)
+      : node_("recorder", lockstep.lcm(), lockstep.clock()) {
+    node_.subscribe<actuator_cmd_t>(channels::kActuatorCmd,
+                                    [this](const actuator_cmd_t& m) { commands.push_back(m); });
+    node_.subscribe<control_status_t>(channels::kControlStatus,
+                                      [this](const control_status_t& m) { status.push_back(m); });
+  }
+  Node& node() { return node_; }
+  std::vector<actuator_cmd_t> commands;
+  std::vector<control_status_t> status;
+
+ private:
+  Node node_;
+};
+
+TEST_F(LockstepServices, ControllerWithoutMissionHoldsPosition) {
+  sim::Lockstep lockstep;
+  const Vec3 here(12.0, -4.0, -25.0);
+  NavFeeder feeder(lockstep, here);
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  BusRecorder recorder(lockstep);
+  lockstep.add(feeder.node());
+  lockstep.add(controller.node());
+  lockstep.add(recorder.node());
+  lockstep.run(to_utime(2.0));
+
+  EXPECT_EQ(controller.mode(), control_status_t::HOLD);
+  ASSERT_FALSE(recorder.status.empty());
+  const control_status_t& s = recorder.status.back();
+  EXPECT_EQ(s.mode, control_status_t::HOLD);
+  EXPECT_EQ(s.mission_id, -1);
+  // Holding where it is: the reference is the vehicle's own position.
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(s.ref_position[i], here[i], 1e-9);
+  // And it flies: commands at the control rate, finite and near hover.
+  EXPECT_GE(recorder.commands.size(), 150u);
+  const vehicle::RotorcraftParams p;
+  const auto hover = vehicle::trim(vehicle::RotorcraftModel(p), Vec3::Zero(), 0.0).controls;
+  for (const auto& c : recorder.commands) {
+    ASSERT_EQ(validate(c), "");
+    EXPECT_NEAR(c.collective, hover.collective, 0.02);
+  }
+  EXPECT_EQ(controller.node().counters().rejected, 0);
+}
+
+TEST_F(LockstepServices, ControllerWithoutNavigationNeverCommands) {
+  sim::Lockstep lockstep;
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  BusRecorder recorder(lockstep);
+  lockstep.add(controller.node());
+  lockstep.add(recorder.node());
+  lockstep.run(to_utime(1.0));
+  EXPECT_EQ(controller.mode(), control_status_t::NAV_STALE);
+  EXPECT_TRUE(recorder.commands.empty());  // never fly blind from the ground
+}
+
+TEST_F(LockstepServices, ControllerCommandsLevelHoverWhenNavigationIsLost) {
+  sim::Lockstep lockstep;
+  NavFeeder feeder(lockstep, Vec3(0, 0, -30));
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  BusRecorder recorder(lockstep);
+  lockstep.add(feeder.node());
+  lockstep.add(controller.node());
+  lockstep.add(recorder.node());
+  lockstep.run(to_utime(1.0));
+  EXPECT_EQ(controller.mode(), control_status_t::HOLD);
+  feeder.enabled = false;
+  recorder.commands.clear();
+  lockstep.run(to_utime(2.0));
+  EXPECT_EQ(controller.mode(), control_status_t::NAV_STALE);
+  ASSERT_FALSE(recorder.commands.empty());
+  // Level hover: no cyclic.
+  EXPECT_EQ(recorder.commands.back().lon_cyclic, 0.0);
+  EXPECT_EQ(recorder.commands.back().lat_cyclic, 0.0);
+}
+
+ref_traj_t three_sample_traj(Utime t0) {
+  ref_traj_t m{};
+  m.utime = t0;
+  m.t0_utime = t0;
+  m.frame = "NED";
+  m.sample_time = {0.0, 1.0, 2.0};
+  m.position = {{0, 0, -30}, {10, 0, -30}, {10, 10, -20}};
+  m.velocity = {{10, 0, 0}, {10, 0, 0}, {0, 10, 10}};
+  m.acceleration = {{0, 0, 0}, {2, 0, 0}, {0, 0, 0}};
+  m.num_samples = 3;
+  return m;
+}
+
+TEST(SampleRefTraj, InterpolatesLinearlyBetweenSamples) {
+  const Utime t0 = 5 * kMicrosPerSecond;
+  const ref_traj_t traj = three_sample_traj(t0);
+  ASSERT_EQ(validate(traj), "");
+
+  const auto mid1 = control::sample_ref_traj(traj, t0 + to_utime(0.5));
+  ASSERT_TRUE(mid1.has_value());
+  EXPECT_NEAR((mid1->position - Vec3(5, 0, -30)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((mid1->velocity - Vec3(10, 0, 0)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((mid1->acceleration - Vec3(1, 0, 0)).norm(), 0.0, 1e-9);
+
+  const auto mid2 = control::sample_ref_traj(traj, t0 + to_utime(1.25));
+  ASSERT_TRUE(mid2.has_value());
+  EXPECT_NEAR((mid2->position - Vec3(10, 2.5, -27.5)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((mid2->velocity - Vec3(7.5, 2.5, 2.5)).norm(), 0.0, 1e-9);
+
+  // The sample instants themselves, including both ends.
+  for (int i = 0; i < 3; ++i) {
+    const auto r = control::sample_ref_traj(traj, t0 + to_utime(i));
+    ASSERT_TRUE(r.has_value()) << i;
+    const auto& p = traj.position[i];
+    EXPECT_NEAR((r->position - Vec3(p[0], p[1], p[2])).norm(), 0.0, 1e-9) << i;
+  }
+  // Time is measured from t0, not from zero.
+  ref_traj_t late = three_sample_traj(0);
+  late.t0_utime = 100 * kMicrosPerSecond;
+  const auto r = control::sample_ref_traj(late, late.t0_utime + to_utime(0.5));
+  ASSERT_TRUE(r.has_value());
+  EXPECT_NEAR(r->position.x(), 5.0, 1e-9);
+}
+
+TEST(SampleRefTraj, OutsideTheSampledSpanIsNothing) {
+  const Utime t0 = 5 * kMicrosPerSecond;
+  const ref_traj_t traj = three_sample_traj(t0);
+  EXPECT_FALSE(control::sample_ref_traj(traj, t0 - 1).has_value());
+  EXPECT_FALSE(control::sample_ref_traj(traj, t0 - to_utime(1.0)).has_value());
+  EXPECT_FALSE(control::sample_ref_traj(traj, t0 + to_utime(2.0) + 1).has_value());
+  EXPECT_FALSE(control::sample_ref_traj(traj, t0 + to_utime(10.0)).has_value());
+}
+
+TEST(SampleRefTraj, SampleTimesAreRelativeToT0) {
+  ref_traj_t traj = three_sample_traj(0);
+  traj.t0_utime = 100 * kMicrosPerSecond;
+  EXPECT_FALSE(control::sample_ref_traj(traj, to_utime(0.5)).has_value());
+  EXPECT_FALSE(control::sample_ref_traj(traj, traj.t0_utime - 1).has_value());
+  EXPECT_TRUE(control::sample_ref_traj(traj, traj.t0_utime).has_value());
+  EXPECT_TRUE(control::sample_ref_traj(traj, traj.t0_utime + to_utime(2.0)).has_value());
+}
+
+TEST(MissionUplink, MissionFromScenarioCarriesThePlanInSI) {
+  const Scenario s = load_scenario(kOpenScenario);
+  const mission_t m = uplink::mission_from_scenario(s, 7);
+  EXPECT_EQ(validate(m), "");
+  EXPECT_EQ(m.mission_id, 7);
+  EXPECT_EQ(m.name, "open");
+  EXPECT_EQ(m.num_waypoints, 2);
+  ASSERT_EQ(m.waypoints.size(), 2u);
+  EXPECT_NEAR(m.waypoints[1].position[0], 152.4, 1e-9);
+  EXPECT_NEAR(m.waypoints[1].position[2], -36.576, 1e-9);
+  EXPECT_NEAR(m.waypoints[1].capture_radius, 3.048, 1e-9);
+  EXPECT_NEAR(m.cruise_speed, 3.048, 1e-9);
+  EXPECT_NEAR(m.limits.max_accel, 0.48768, 1e-9);
+}
+
+}  // namespace
+}  // namespace ofn

@@ -1,0 +1,245 @@
+// Nominal waypoint guidance: speed and acceleration limits, leg switching,
+// stopping at the last waypoint and picking up a plan mid-flight.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "ofn/controller/waypoint_guidance.hpp"
+
+namespace ofn::control {
+namespace {
+
+constexpr double kDt = 0.01;
+
+Limits limits(double max_speed, double max_accel, double max_vertical_speed) {
+  Limits l;
+  l.max_speed = max_speed;
+  l.max_accel = max_accel;
+  l.max_vertical_speed = max_vertical_speed;
+  return l;
+}
+
+/// Flies a fake vehicle that sits exactly on the reference (position and
+/// velocity copied from it each step) and records every reference.
+struct PerfectFollower {
+  WaypointGuidance guidance;
+  Vec3 position, velocity = Vec3::Zero();
+  std::vector<GuidanceReference> refs;
+  std::vector<Vec3> positions;  // vehicle position passed to each update
+
+  PerfectFollower(const std::vector<Waypoint>& wps, double cruise, const Limits& lim, Vec3 start,
+                  GuidanceConfig config = {})
+      : guidance(config), position(start) {
+    guidance.set_mission(wps, cruise, lim, position, velocity);
+  }
+
+  /// Runs until done (or `max_seconds`); returns whether it arrived.
+  bool run(double max_seconds) {
+    const int steps = static_cast<int>(max_seconds / kDt);
+    for (int i = 0; i < steps; ++i) {
+      positions.push_back(position);
+      const GuidanceReference r = guidance.update(position, velocity, kDt);
+      refs.push_back(r);
+      position = r.position;
+      velocity = r.velocity;
+      if (r.done) return true;
+    }
+    return false;
+  }
+};
+
+TEST(WaypointGuidance, WithoutMissionGivesNoWaypoint) {
+  WaypointGuidance g;
+  EXPECT_FALSE(g.has_mission());
+  const GuidanceReference r = g.update(Vec3(1, 2, 3), Vec3::Zero(), kDt);
+  EXPECT_EQ(r.active_waypoint, -1);
+  EXPECT_FALSE(r.done);
+}
+
+TEST(WaypointGuidance, StraightLegRespectsSpeedAndAccelerationLimitsAndStopsAtTheEnd) {
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(100, 0, -30), 2.0}};
+  const GuidanceConfig config;  // accel_fraction 0.8
+  const double cruise = 3.0, max_accel = 0.5;
+  PerfectFollower f(wps, cruise, limits(3.0, max_accel, 1.0), wps[0].position, config);
+  ASSERT_TRUE(f.guidance.has_mission());
+  const bool arrived = f.run(120.0);
+  ASSERT_TRUE(arrived) << "not done after 120 s; at " << f.position.transpose();
+
+  double max_speed = 0, max_accel_seen = 0, previous_x = -1e9;
+  for (const auto& r : f.refs) {
+    const double speed = r.velocity.norm();
+    max_speed = std::max(max_speed, speed);
+    max_accel_seen = std::max(max_accel_seen, r.acceleration.norm());
+    EXPECT_LE(speed, cruise + 1e-6);
+    EXPECT_LE(r.acceleration.norm(), config.accel_fraction * max_accel + 1e-9);
+    // The reference stays on the leg, moves only forward and never passes the end.
+    EXPECT_LE(r.position.x(), 100.0 + 1e-9);
+    EXPECT_GE(r.position.x(), previous_x - 1e-12);
+    EXPECT_NEAR(r.position.y(), 0.0, 1e-12);
+    EXPECT_NEAR(r.position.z(), -30.0, 1e-12);
+    EXPECT_EQ(r.active_waypoint, 1);
+    previous_x = r.position.x();
+  }
+  EXPECT_GT(max_speed, 0.98 * cruise);                                 // reaches cruise
+  EXPECT_GT(max_accel_seen, 0.5 * config.accel_fraction * max_accel);  // actually accelerates
+
+  const GuidanceReference& last = f.refs.back();
+  EXPECT_TRUE(last.done);
+  EXPECT_LE((last.position - wps[1].position).norm(), wps[1].capture_radius);
+  EXPECT_LE(last.velocity.norm(), config.stop_speed);
+  // Not done any earlier than inside the capture radius.
+  for (size_t i = 0; i + 1 < f.refs.size(); ++i) {
+    if (f.refs[i].done) {
+      EXPECT_LE((f.positions[i] - wps[1].position).norm(), wps[1].capture_radius);
+    }
+  }
+  // A flight of 100 m at 3 m/s with gentle ramps: well under a minute.
+  EXPECT_LT(f.refs.size() * kDt, 60.0);
+  EXPECT_GT(f.refs.size() * kDt, 100.0 / cruise);
+}
+
+TEST(WaypointGuidance, StaysDoneAndStillAtTheLastWaypoint) {
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(20, 0, -30), 2.0}};
+  PerfectFollower f(wps, 3.0, limits(3.0, 0.5, 1.0), wps[0].position);
+  ASSERT_TRUE(f.run(60.0));
+  for (int i = 0; i < 500; ++i) {
+    const GuidanceReference r = f.guidance.update(f.position, f.velocity, kDt);
+    EXPECT_TRUE(r.done);
+    EXPECT_LE(r.position.x(), 20.0 + 1e-9);
+    EXPECT_LE(r.velocity.norm(), 1e-9);
+    f.position = r.position;
+    f.velocity = r.velocity;
+  }
+}
+
+TEST(WaypointGuidance, SwitchesLegsInsideTheCaptureRadius) {
+  const double radius = 5.0;
+  const std::vector<Waypoint> wps = {
+      {Vec3(0, 0, -30), radius}, {Vec3(50, 0, -30), radius}, {Vec3(50, 50, -30), radius}};
+  const GuidanceConfig config;
+  const double max_accel = 0.5;
+  PerfectFollower f(wps, 3.0, limits(3.0, max_accel, 1.0), wps[0].position, config);
+  ASSERT_TRUE(f.run(200.0)) << "at " << f.position.transpose();
+
+  std::vector<int> sequence;
+  size_t switch_index = 0;
+  for (size_t i = 0; i < f.refs.size(); ++i) {
+    const int active = f.refs[i].active_waypoint;
+    if (sequence.empty() || sequence.back() != active) {
+      sequence.push_back(active);
+      if (active == 2) switch_index = i;
+    }
+    EXPECT_LE(f.refs[i].velocity.norm(), 3.0 + 1e-6);
+    EXPECT_LE(f.refs[i].acceleration.norm(), config.accel_fraction * max_accel + 1e-9);
+  }
+  EXPECT_EQ(sequence, (std::vector<int>{1, 2}));
+  ASSERT_GT(switch_index, 0u);
+  // Switched on the first update with the vehicle inside the capture radius
+  // of the corner, not before.
+  const double at_switch = (f.positions[switch_index] - wps[1].position).norm();
+  const double before_switch = (f.positions[switch_index - 1] - wps[1].position).norm();
+  EXPECT_LE(at_switch, radius);
+  EXPECT_GT(before_switch, radius);
+  // The second leg heads (nearly) east, from where the reference was to the
+  // last waypoint.
+  EXPECT_GT(f.refs[switch_index].leg_direction.y(), 0.99)
+      << f.refs[switch_index].leg_direction.transpose();
+  // And it ends at the last waypoint.
+  EXPECT_LE((f.refs.back().position - wps[2].position).norm(), radius);
+}
+
+TEST(WaypointGuidance, RestartMidLegPicksUpTheLegTheVehicleIsOn) {
+  const std::vector<Waypoint> wps = {
+      {Vec3(0, 0, -30), 5.0}, {Vec3(50, 0, -30), 5.0}, {Vec3(50, 50, -30), 5.0}};
+  WaypointGuidance g;
+  const Vec3 position(50.4, 24.0, -30.2);  // near the middle of leg 2
+  const Vec3 velocity(0.0, 3.0, 0.0);
+  g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), position, velocity);
+  const GuidanceReference r = g.update(position, velocity, kDt);
+  EXPECT_EQ(r.active_waypoint, 2);
+  // No jump: the reference starts at the vehicle's projection on the leg,
+  // moving at the vehicle's speed along it.
+  EXPECT_LT((r.position - Vec3(50, 24, -30)).norm(), 0.1);
+  EXPECT_NEAR(r.velocity.y(), 3.0, 0.05);
+  EXPECT_TRUE(r.leg_direction.isApprox(Vec3::UnitY()));
+}
+
+TEST(WaypointGuidance, RestartNearTheFirstLegStartsThere) {
+  const std::vector<Waypoint> wps = {
+      {Vec3(0, 0, -30), 5.0}, {Vec3(50, 0, -30), 5.0}, {Vec3(50, 50, -30), 5.0}};
+  WaypointGuidance g;
+  g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), Vec3(20, 1, -30), Vec3::Zero());
+  EXPECT_EQ(g.update(Vec3(20, 1, -30), Vec3::Zero(), kDt).active_waypoint, 1);
+}
+
+TEST(WaypointGuidance, VerticalLegRespectsMaxVerticalSpeed) {
+  const double max_vertical = 1.0;
+  // Straight up 30 m.
+  {
+    const std::vector<Waypoint> wps = {{Vec3(0, 0, -10), 2.0}, {Vec3(0, 0, -40), 2.0}};
+    PerfectFollower f(wps, 3.0, limits(3.0, 0.5, max_vertical), wps[0].position);
+    ASSERT_TRUE(f.run(120.0));
+    double max_vz = 0;
+    for (const auto& r : f.refs) {
+      EXPECT_LE(std::abs(r.velocity.z()), max_vertical + 1e-9);
+      EXPECT_GE(r.position.z(), -40.0 - 1e-9);  // never above the top waypoint
+      max_vz = std::max(max_vz, std::abs(r.velocity.z()));
+    }
+    EXPECT_GT(max_vz, 0.95 * max_vertical);
+    EXPECT_NEAR(f.refs.back().position.z(), -40.0, 2.0);
+  }
+  // A climbing leg: 30 m north, 30 m up; the climb rate is the limit, not
+  // the cruise speed.
+  {
+    const std::vector<Waypoint> wps = {{Vec3(0, 0, -10), 2.0}, {Vec3(30, 0, -40), 2.0}};
+    PerfectFollower f(wps, 3.0, limits(3.0, 0.5, max_vertical), wps[0].position);
+    ASSERT_TRUE(f.run(200.0));
+    double max_speed = 0;
+    for (const auto& r : f.refs) {
+      EXPECT_LE(std::abs(r.velocity.z()), max_vertical + 1e-9);
+      max_speed = std::max(max_speed, r.velocity.norm());
+    }
+    // Along the leg at most max_vertical / sin(climb angle).
+    const double slope_limit = max_vertical * std::hypot(30.0, 30.0) / 30.0;
+    ASSERT_LT(slope_limit, 3.0);
+    EXPECT_LE(max_speed, slope_limit + 1e-6);
+    EXPECT_GT(max_speed, 0.95 * slope_limit);
+  }
+}
+
+TEST(WaypointGuidance, ReferenceWaitsForALaggingVehicle) {
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(200, 0, -30), 2.0}};
+  const GuidanceConfig config;
+  WaypointGuidance g(config);
+  const Vec3 stuck(0, 0, -30);
+  g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), stuck, Vec3::Zero());
+  const double max_accel = 0.5, cruise = 3.0;
+  GuidanceReference r;
+  for (int i = 0; i < 3000; ++i) r = g.update(stuck, Vec3::Zero(), kDt);
+  const double after_30s = r.position.x();
+  for (int i = 0; i < 3000; ++i) r = g.update(stuck, Vec3::Zero(), kDt);
+  // The rubber band asks for zero speed two leads ahead; past that the
+  // reference can only coast through its braking distance.
+  const double braking = cruise * cruise / (2.0 * config.accel_fraction * max_accel);
+  EXPECT_LE(r.position.x(), 2.0 * config.max_lead + braking);
+  EXPECT_GT(r.position.x(), config.max_lead);
+  EXPECT_NEAR(r.position.x(), after_30s, 1e-6);  // it has stopped
+  EXPECT_LT(r.velocity.norm(), 1e-6);
+  EXPECT_FALSE(r.done);
+}
+
+TEST(WaypointGuidance, ClearRemovesTheMission) {
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(100, 0, -30), 2.0}};
+  WaypointGuidance g;
+  g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), wps[0].position, Vec3::Zero());
+  EXPECT_TRUE(g.has_mission());
+  g.clear();
+  EXPECT_FALSE(g.has_mission());
+  EXPECT_EQ(g.update(Vec3::Zero(), Vec3::Zero(), kDt).active_waypoint, -1);
+}
+
+}  // namespace
+}  // namespace ofn::control
