@@ -1,0 +1,886 @@
+#!/usr/bin/python3
+"""Start, supervise and record the flight-software services of one run.
+
+Reads the process table (deploy/processes.yaml), starts lcm-logger and then
+every selected service in table order, pins each to its host's CPU core,
+restarts crashed services with exponential backoff, and stops everything
+cleanly when the run ends (ends_run process exits, --timeout, Ctrl-C or
+SIGTERM).
+
+Each service's output goes to the terminal prefixed with [name] and to
+<log_dir>/<flight-stem>/<name>.log; the LCM traffic goes to
+<log_dir>/<flight-stem>.lcm, whose path is also written to
+<log_dir>/latest_log.
+
+Exit codes: the ends_run process's exit code when it ends the run; 2 for bad
+input (table, arguments, missing executables); 3 when --timeout ends the run;
+128+N when stopped by signal N; 1 when the launcher could not run (e.g.
+lcm-logger failed) or every service stopped without an ends_run process.
+
+Only the Python standard library and PyYAML are used so that the launcher
+runs unchanged on the onboard computers (Debian: python3-yaml).
+"""
+
+import argparse
+import datetime
+import os
+import re
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+try:
+    import yaml
+except ImportError:  # pragma: no cover - depends on the host
+    sys.stderr.write("launch.py: PyYAML is missing: apt-get install python3-yaml\n")
+    sys.exit(2)
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_TABLE = os.path.join(REPO_ROOT, "deploy", "processes.yaml")
+DEFAULT_BIN = os.path.join(REPO_ROOT, "build", "bin")
+DEFAULT_LOG_DIR = os.path.join(REPO_ROOT, "results")
+FALLBACK_LCM_URL = "udpm://239.255.76.67:7667?ttl=0"
+
+EXIT_BAD_INPUT = 2
+EXIT_TIMEOUT = 3
+EXIT_LAUNCHER_FAILURE = 1
+
+# Restart backoff: 0.5 s, 1 s, 2 s, 4 s, 8 s, 8 s, ...  Short enough that a
+# flaky service is back quickly, long enough that a service crashing at
+# start-up does not spin the CPU the controller shares.
+BACKOFF_START_S = 0.5
+BACKOFF_CAP_S = 8.0
+
+# Time each group of children gets to exit after SIGINT before SIGKILL.
+STOP_GRACE_S = 3.0
+
+# The ends_run process receives the same {timeout}; the launcher waits this
+# much longer so that the monitor's own timeout verdict wins the race against
+# the launcher's hard limit.
+ENDS_RUN_TIMEOUT_GRACE_S = 5.0
+
+# Time lcm-logger gets to join the multicast group before services publish.
+LOGGER_SETTLE_S = 0.5
+
+POLL_INTERVAL_S = 0.05
+
+PLACEHOLDERS = ("bin", "scenario", "rtf", "lcm_url", "timeout", "log_dir")
+# "{name}" but not "${name}", so shell snippets in commands keep working.
+PLACEHOLDER_RE = re.compile(r"(?<!\$)\{([A-Za-z_][A-Za-z0-9_]*)\}")
+NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
+
+REQUIRED_FIELDS = {"name": str, "host": str, "core": int, "command": list}
+OPTIONAL_FIELDS = {"config": str, "restart": bool, "ends_run": bool, "priority": int}
+
+
+class TableError(Exception):
+    """Invalid process table or launch input; reported with exit code 2."""
+
+
+class ProcessSpec:
+    """One validated entry of the process table."""
+
+    def __init__(self, name, host, core, command, config=None, restart=False,
+                 ends_run=False, priority=None):
+        self.name = name
+        self.host = host
+        self.core = core
+        self.command = list(command)
+        self.config = config          # absolute path or None
+        self.restart = restart
+        self.ends_run = ends_run
+        self.priority = priority
+
+    def __repr__(self):
+        return "ProcessSpec(%r, host=%r, core=%r)" % (self.name, self.host, self.core)
+
+
+class ProcessTable:
+    def __init__(self, path, hosts, processes):
+        self.path = path
+        self.hosts = hosts            # host name -> list of cores
+        self.processes = processes    # list of ProcessSpec, in start order
+
+    def names(self):
+        return [p.name for p in self.processes]
+
+
+# ---------------------------------------------------------------------------
+# Table loading and validation
+# ---------------------------------------------------------------------------
+
+def _type_name(t):
+    return {str: "a string", int: "an integer", list: "a list", bool: "true/false",
+            dict: "a mapping"}.get(t, t.__name__)
+
+
+def _is_type(value, expected):
+    # bool is a subclass of int; "core: true" must not pass as core 1.
+    if expected is int:
+        return isinstance(value, int) and not isinstance(value, bool)
+    return isinstance(value, expected)
+
+
+def _display_path(path):
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:
+        return path
+    return rel if not rel.startswith("..") else path
+
+
+def resolve_repo_path(path):
+    """Paths in the table are relative to the repository root."""
+    path = os.path.expanduser(path)
+    return path if os.path.isabs(path) else os.path.normpath(os.path.join(REPO_ROOT, path))
+
+
+def load_table(path):
+    """Parse and validate a process table; raise TableError on any problem.
+
+    Checks structure and types only; executables and config files are checked
+    by check_files() for the processes actually being started.
+    """
+    shown = _display_path(path)
+    try:
+        with open(path, "r", encoding="utf-8") as f:
+            doc = yaml.safe_load(f)
+    except FileNotFoundError:
+        raise TableError("%s: process table not found" % shown)
+    except OSError as e:
+        raise TableError("%s: cannot read process table: %s" % (shown, e.strerror))
+    except yaml.YAMLError as e:
+        raise TableError("%s: not valid YAML: %s" % (shown, e))
+
+    if not isinstance(doc, dict):
+        raise TableError("%s: top level must be a mapping with 'hosts' and 'processes'" % shown)
+    for key in doc:
+        if key not in ("hosts", "processes"):
+            raise TableError("%s: unknown top-level field '%s' (expected 'hosts' and 'processes')"
+                             % (shown, key))
+
+    hosts_doc = doc.get("hosts")
+    if hosts_doc is None:
+        raise TableError("%s: missing field 'hosts'" % shown)
+    if not isinstance(hosts_doc, dict) or not hosts_doc:
+        raise TableError("%s: field 'hosts' must be a non-empty mapping of host name -> {cores: [...]}"
+                         % shown)
+    hosts = {}
+    for host_name, host_doc in hosts_doc.items():
+        where = "%s: hosts.%s" % (shown, host_name)
+        if not isinstance(host_doc, dict) or "cores" not in host_doc:
+            raise TableError("%s: missing field 'cores'" % where)
+        for key in host_doc:
+            if key != "cores":
+                raise TableError("%s: unknown field '%s' (only 'cores' is allowed)" % (where, key))
+        cores = host_doc["cores"]
+        if (not isinstance(cores, list) or not cores
+                or not all(_is_type(c, int) and c >= 0 for c in cores)):
+            raise TableError("%s: field 'cores' must be a non-empty list of core numbers >= 0, got %r"
+                             % (where, cores))
+        hosts[str(host_name)] = cores
+
+    procs_doc = doc.get("processes")
+    if procs_doc is None:
+        raise TableError("%s: missing field 'processes'" % shown)
+    if not isinstance(procs_doc, list) or not procs_doc:
+        raise TableError("%s: field 'processes' must be a non-empty list" % shown)
+
+    processes = []
+    seen = set()
+    for index, entry in enumerate(procs_doc):
+        label = "processes[%d]" % index
+        if isinstance(entry, dict) and isinstance(entry.get("name"), str):
+            label += " (%s)" % entry["name"]
+        where = "%s: %s" % (shown, label)
+        if not isinstance(entry, dict):
+            raise TableError("%s: entry must be a mapping, got %r" % (where, entry))
+
+        for field, expected in REQUIRED_FIELDS.items():
+            if field not in entry:
+                raise TableError("%s: missing field '%s'" % (where, field))
+        for field, value in entry.items():
+            expected = REQUIRED_FIELDS.get(field) or OPTIONAL_FIELDS.get(field)
+            if expected is None:
+                known = ", ".join(list(REQUIRED_FIELDS) + list(OPTIONAL_FIELDS))
+                raise TableError("%s: unknown field '%s' (known fields: %s)" % (where, field, known))
+            if not _is_type(value, expected):
+                raise TableError("%s: field '%s' must be %s, got %r"
+                                 % (where, field, _type_name(expected), value))
+
+        name = entry["name"]
+        if not NAME_RE.match(name):
+            raise TableError("%s: field 'name': %r may only contain letters, digits, '_', '-', '.'"
+                             % (where, name))
+        if name in seen:
+            raise TableError("%s: field 'name': duplicate process name '%s'" % (where, name))
+        seen.add(name)
+
+        host = entry["host"]
+        if host not in hosts:
+            raise TableError("%s: field 'host': unknown host '%s' (known hosts: %s)"
+                             % (where, host, ", ".join(hosts)))
+        core = entry["core"]
+        if core not in hosts[host]:
+            raise TableError("%s: field 'core': core %d is not one of host %s's cores %s"
+                             % (where, core, host, hosts[host]))
+
+        command = entry["command"]
+        if not command or not all(isinstance(a, str) for a in command):
+            raise TableError("%s: field 'command' must be a non-empty list of strings, got %r"
+                             % (where, command))
+        for arg in command:
+            for placeholder in PLACEHOLDER_RE.findall(arg):
+                if placeholder not in PLACEHOLDERS:
+                    raise TableError("%s: field 'command': unknown placeholder {%s} (known: %s)"
+                                     % (where, placeholder,
+                                        ", ".join("{%s}" % p for p in PLACEHOLDERS)))
+
+        priority = entry.get("priority")
+        if priority is not None and not 1 <= priority <= 99:
+            raise TableError("%s: field 'priority' must be a SCHED_FIFO priority 1..99, got %d"
+                             % (where, priority))
+        restart = entry.get("restart", False)
+        ends_run = entry.get("ends_run", False)
+        if restart and ends_run:
+            raise TableError("%s: fields 'restart' and 'ends_run' cannot both be true "
+                             "(the process that ends the run must not be restarted)" % where)
+
+        config = entry.get("config")
+        processes.append(ProcessSpec(
+            name=name, host=host, core=core, command=command,
+            config=resolve_repo_path(config) if config is not None else None,
+            restart=restart, ends_run=ends_run, priority=priority))
+
+    return ProcessTable(path, hosts, processes)
+
+
+def select_processes(table, only=None, host=None):
+    """Processes to start: table order, filtered by --only names and --host."""
+    selected = list(table.processes)
+    if host is not None:
+        if host not in table.hosts:
+            raise TableError("--host: unknown host '%s' (hosts in %s: %s)"
+                             % (host, _display_path(table.path), ", ".join(table.hosts)))
+        selected = [p for p in selected if p.host == host]
+    if only:
+        unknown = [n for n in only if n not in table.names()]
+        if unknown:
+            raise TableError("--only: unknown process name(s) %s (processes in %s: %s)"
+                             % (", ".join(unknown), _display_path(table.path),
+                                ", ".join(table.names())))
+        selected = [p for p in selected if p.name in only]
+    if not selected:
+        raise TableError("no processes selected (check --only / --host)")
+    return selected
+
+
+def expand_command(spec, values):
+    """Fill in placeholders; append --config <path> when the entry has one."""
+    def substitute(arg):
+        return PLACEHOLDER_RE.sub(lambda m: values.get(m.group(1), m.group(0)), arg)
+
+    argv = [substitute(a) for a in spec.command]
+    if spec.config is not None:
+        argv += ["--config", spec.config]
+    return argv
+
+
+def resolve_executable(program):
+    """Absolute path of an executable, or None.
+
+    Absolute paths (/bin/sh) are used as they are, paths with a slash are
+    relative to the repository root, bare names are looked up on PATH.
+    """
+    if "/" in program:
+        path = resolve_repo_path(program)
+        return path if os.path.isfile(path) and os.access(path, os.X_OK) else None
+    return shutil.which(program)
+
+
+def check_files(table, specs, values):
+    """Executables and config files of the selected processes must exist."""
+    shown = _display_path(table.path)
+    for spec in specs:
+        where = "%s: process '%s'" % (shown, spec.name)
+        argv = expand_command(spec, values)
+        if resolve_executable(argv[0]) is None:
+            if "/" in argv[0]:
+                path = resolve_repo_path(argv[0])
+                # {bin} and work-tree executables come from the build.
+                from_build = "{bin}" in spec.command[0] or path.startswith(REPO_ROOT + os.sep)
+                hint = " - build first: make build" if from_build else ""
+                raise TableError("%s: field 'command': executable %s not found or not executable%s"
+                                 % (where, path, hint))
+            raise TableError("%s: field 'command': executable '%s' not found on PATH"
+                             % (where, argv[0]))
+        if spec.config is not None and not os.path.isfile(spec.config):
+            raise TableError("%s: field 'config': file %s not found" % (where, spec.config))
+
+
+# ---------------------------------------------------------------------------
+# CPU pinning and priority
+# ---------------------------------------------------------------------------
+
+def clamp_core(core, ncpu):
+    """Clamp a table core number to the cores this machine has.
+
+    The table describes the real three-host split; on a smaller development
+    machine the emulated hosts share the last core instead of failing.
+    """
+    ncpu = max(1, int(ncpu or 1))
+    return max(0, min(int(core), ncpu - 1))
+
+
+class Pinning:
+    """Decides, once per run, how processes are pinned and prioritised."""
+
+    def __init__(self, enabled, note):
+        self.note = note
+        self.ncpu = os.cpu_count() or 1
+        try:
+            self.allowed = os.sched_getaffinity(0)
+        except (AttributeError, OSError):
+            self.allowed = set(range(self.ncpu))
+        self.taskset = shutil.which("taskset") if enabled else None
+        if not enabled:
+            note("CPU pinning disabled (--no-pin)")
+        elif self.taskset is None:
+            note("taskset not found (apt-get install util-linux); processes are not pinned")
+        self._chrt_checked = {}
+
+    def prefix(self, spec):
+        """Command prefix (chrt/taskset) for one process."""
+        prefix = []
+        if spec.priority is not None and self._chrt_usable(spec.priority):
+            prefix += [shutil.which("chrt"), "-f", str(spec.priority)]
+            self.note("%s: real-time priority SCHED_FIFO %d" % (spec.name, spec.priority))
+        if self.taskset is not None:
+            core = clamp_core(spec.core, self.ncpu)
+            if core != spec.core:
+                self.note("%s: table core %d clamped to %d (this machine has %d CPU%s)"
+                          % (spec.name, spec.core, core, self.ncpu, "" if self.ncpu == 1 else "s"))
+            if core in self.allowed:
+                prefix += [self.taskset, "-c", str(core)]
+            else:
+                self.note("%s: core %d is outside this launcher's allowed CPUs %s; not pinned"
+                          % (spec.name, core, sorted(self.allowed)))
+        return prefix
+
+    def _chrt_usable(self, priority):
+        if priority in self._chrt_checked:
+            return self._chrt_checked[priority]
+        usable = False
+        chrt = shutil.which("chrt")
+        if os.geteuid() != 0:
+            self.note("priority %d (SCHED_FIFO) needs root; running with normal priority" % priority)
+        elif chrt is None:
+            self.note("chrt not found; priority %d not applied" % priority)
+        else:
+            # Containers and some kernels refuse SCHED_FIFO even to root; try it.
+            try:
+                rc = subprocess.run([chrt, "-f", str(priority), "true"], stdout=subprocess.DEVNULL,
+                                    stderr=subprocess.DEVNULL, timeout=5).returncode
+            except (OSError, subprocess.TimeoutExpired):
+                rc = 1
+            usable = rc == 0
+            if not usable:
+                self.note("chrt -f %d refused on this machine; running with normal priority"
+                          % priority)
+        self._chrt_checked[priority] = usable
+        return usable
+
+
+# ---------------------------------------------------------------------------
+# Child processes
+# ---------------------------------------------------------------------------
+
+def describe_exit(returncode):
+    """(shell-style exit code, human text) for a Popen return code."""
+    if returncode is None:
+        return None, "still running"
+    if returncode < 0:
+        signum = -returncode
+        try:
+            signame = signal.Signals(signum).name
+        except ValueError:
+            signame = "signal %d" % signum
+        return 128 + signum, "exited with code %d (signal %s)" % (128 + signum, signame)
+    return returncode, "exited with code %d" % returncode
+
+
+class Console:
+    """Serialises terminal output of the launcher and the reader threads."""
+
+    def __init__(self, width):
+        self.lock = threading.Lock()
+        self.width = width
+        # Once the terminal is gone (closed ssh session, "| head"), output
+        # goes only to the log files; the run and the shutdown must go on.
+        self.broken = False
+
+    def _write(self, data):
+        with self.lock:
+            if self.broken:
+                return
+            try:
+                sys.stdout.buffer.write(data)
+                sys.stdout.buffer.flush()
+            except (OSError, ValueError):
+                self.broken = True
+
+    def service_line(self, name, line):
+        prefix = ("[%s]" % name).ljust(self.width + 2).encode()
+        self._write(prefix + b" " + line)
+
+    def say(self, text):
+        self._write(("launcher: %s\n" % text).encode("utf-8", "replace"))
+
+    def note(self, text):
+        self.say("note: " + text)
+
+
+class Child:
+    """One supervised child process (a service or lcm-logger)."""
+
+    RUNNING = "running"    # started (or being started); exit not yet handled
+    WAITING = "waiting"    # exited, restart scheduled at restart_at
+    DONE = "done"          # exited for good (no restart, gave up, ends_run)
+
+    def __init__(self, name, argv, log_path, console, spec=None, file_only=None):
+        self.name = name
+        self.file_only = file_only   # regex of lines kept out of the terminal
+        self.argv = argv
+        self.log_path = log_path
+        self.console = console
+        self.spec = spec
+        self.proc = None
+        self.reader = None
+        self.state = Child.RUNNING
+        self.starts = 0
+        self.restarts = 0
+        self.restart_at = None       # monotonic time of a pending restart
+        self.gave_up = False
+        self.last_returncode = None
+        self.stopped_by_launcher = False
+
+    def alive(self):
+        return self.proc is not None and self.proc.poll() is None
+
+    def start(self, env):
+        """Start the child; returns False if it could not be executed."""
+        self.state = Child.RUNNING
+        self.starts += 1
+        log = open(self.log_path, "ab")
+        stamp = datetime.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
+        header = "=== launcher %s: start #%d: %s\n" % (stamp, self.starts, shlex.join(self.argv))
+        log.write(header.encode())
+        log.flush()
+        try:
+            # A new session per child: Ctrl-C in the terminal reaches only the
+            # launcher, which then stops the children in a defined order (the
+            # logger last), and killpg() also reaches anything a child forked.
+            self.proc = subprocess.Popen(
+                self.argv, cwd=REPO_ROOT, env=env, stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+        except OSError as e:
+            log.write(("=== launcher: failed to start: %s\n" % e).encode())
+            log.close()
+            self.console.say("%s failed to start: %s" % (self.name, e))
+            self.proc = None
+            self.last_returncode = 127
+            return False
+        self.reader = threading.Thread(target=self._pump, args=(self.proc.stdout, log),
+                                       name="reader-" + self.name, daemon=True)
+        self.reader.start()
+        return True
+
+    def _pump(self, stream, log):
+        try:
+            for line in iter(stream.readline, b""):
+                if not line.endswith(b"\n"):
+                    line += b"\n"
+                log.write(line)
+                log.flush()
+                if self.file_only is None or not self.file_only.match(line):
+                    self.console.service_line(self.name, line)
+        except (OSError, ValueError):
+            pass
+        finally:
+            stream.close()
+            log.close()
+
+    def finish_output(self, timeout=0.5):
+        # Lets the last lines of a dead child reach the terminal before the
+        # launcher's message about it.  Bounded: a forked grandchild may still
+        # hold the pipe open.
+        if self.reader is not None:
+            self.reader.join(timeout)
+
+    def signal_group(self, signum):
+        if self.proc is None:
+            return
+        try:
+            os.killpg(self.proc.pid, signum)
+        except (ProcessLookupError, PermissionError):
+            pass
+
+
+def stop_children(children, console, state, grace=STOP_GRACE_S):
+    """SIGINT every live child, wait up to `grace`, SIGKILL stragglers."""
+    live = [c for c in children if c.alive()]
+    if not live:
+        return
+    for child in live:
+        child.stopped_by_launcher = True
+        child.signal_group(signal.SIGINT)
+    deadline = time.monotonic() + grace
+    while time.monotonic() < deadline and not state.force_kill:
+        if not any(c.alive() for c in live):
+            break
+        time.sleep(POLL_INTERVAL_S)
+    for child in live:
+        if child.alive():
+            console.say("%s did not stop within %.0f s of SIGINT; sending SIGKILL"
+                        % (child.name, grace))
+        # Also clears anything the child forked that outlived it.
+        child.signal_group(signal.SIGKILL)
+    for child in live:
+        try:
+            child.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            console.say("%s (pid %d) survived SIGKILL" % (child.name, child.proc.pid))
+        child.last_returncode = child.proc.returncode
+        child.finish_output()
+
+
+class RunState:
+    """Flags set from signal handlers and read by the supervision loop."""
+
+    def __init__(self):
+        self.stop_signal = None
+        self.stopping = False
+        self.force_kill = False
+
+
+# ---------------------------------------------------------------------------
+# Command line and main
+# ---------------------------------------------------------------------------
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(
+        prog="deploy/launch.py",
+        description="Start, supervise and record the flight-software services of one run.",
+        epilog="Examples:\n"
+               "  deploy/launch.py --scenario scenarios/hover.yaml\n"
+               "  deploy/launch.py --scenario S --only mapper,global_planner --no-record --timeout 0\n"
+               "      (re-run planners on a flight replayed with deploy/replay.sh)\n"
+               "  deploy/launch.py --scenario S --host onboard1 --timeout 0   (on the flight computer)",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--table", default=DEFAULT_TABLE,
+                        help="process table (default: deploy/processes.yaml)")
+    parser.add_argument("--scenario", required=True, help="scenario file, substituted for {scenario}")
+    parser.add_argument("--bin", default=DEFAULT_BIN,
+                        help="directory of the service executables, {bin} (default: build/bin)")
+    parser.add_argument("--rtf", type=float, default=1.0,
+                        help="simulation real-time factor, {rtf} (default: 1.0)")
+    parser.add_argument("--lcm-url", default=os.environ.get("LCM_DEFAULT_URL") or FALLBACK_LCM_URL,
+                        help="LCM URL, {lcm_url} (default: $LCM_DEFAULT_URL or %s)"
+                             % FALLBACK_LCM_URL.replace("%", "%%"))
+    parser.add_argument("--log-dir", default=DEFAULT_LOG_DIR,
+                        help="where flight logs and service logs go, {log_dir} (default: results/)")
+    parser.add_argument("--timeout", type=float, default=300.0,
+                        help="overall wall-clock run limit in seconds, also {timeout}; "
+                             "0 = no launcher limit, {timeout} then is 0 (default: 300)")
+    parser.add_argument("--no-pin", action="store_true", help="do not pin processes to cores")
+    parser.add_argument("--no-record", action="store_true", help="do not start lcm-logger")
+    parser.add_argument("--only", metavar="NAME[,NAME]",
+                        help="start only these processes (comma-separated)")
+    parser.add_argument("--host", help="start only the processes of this host")
+    parser.add_argument("--max-restarts", type=int, default=5,
+                        help="restarts per service before giving up (default: 5)")
+    args = parser.parse_args(argv)
+
+    errors = []
+    if not args.rtf > 0:
+        errors.append("--rtf must be > 0")
+    if args.timeout < 0:
+        errors.append("--timeout must be >= 0")
+    if args.max_restarts < 0:
+        errors.append("--max-restarts must be >= 0")
+    for message in errors:
+        parser.error(message)  # exits with code 2
+    args.only = [n.strip() for n in args.only.split(",") if n.strip()] if args.only else None
+    return args
+
+
+def format_number(value):
+    """300.0 -> "300", 0.5 -> "0.5": services may parse {timeout} as an integer."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))
+
+
+def unique_log_stem(log_dir):
+    stem = "flight-" + datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+    candidate, n = stem, 1
+    # Two runs within the same second must not share (and clobber) a log.
+    while (os.path.exists(os.path.join(log_dir, candidate + ".lcm"))
+           or os.path.exists(os.path.join(log_dir, candidate))):
+        n += 1
+        candidate = "%s-%d" % (stem, n)
+    return candidate
+
+
+def main(argv=None):
+    args = parse_args(argv)
+
+    table_path = os.path.abspath(args.table)
+    scenario = os.path.abspath(os.path.expanduser(args.scenario))
+    bin_dir = os.path.abspath(os.path.expanduser(args.bin))
+    log_dir = os.path.abspath(os.path.expanduser(args.log_dir))
+
+    values = {
+        "bin": bin_dir,
+        "scenario": scenario,
+        "rtf": format_number(args.rtf),
+        "lcm_url": args.lcm_url,
+        "timeout": format_number(args.timeout),
+        "log_dir": log_dir,
+    }
+
+    try:
+        table = load_table(table_path)
+        specs = select_processes(table, args.only, args.host)
+        if not os.path.isfile(scenario):
+            raise TableError("--scenario: file %s not found" % scenario)
+        check_files(table, specs, values)
+        logger_exe = None
+        if not args.no_record:
+            logger_exe = shutil.which("lcm-logger")
+            if logger_exe is None:
+                raise TableError("lcm-logger not found (apt-get install lcm), or pass --no-record")
+    except TableError as e:
+        sys.stderr.write("launch.py: error: %s\n" % e)
+        return EXIT_BAD_INPUT
+
+    try:
+        os.makedirs(log_dir, exist_ok=True)
+        stem = unique_log_stem(log_dir)
+        service_log_dir = os.path.join(log_dir, stem)
+        os.makedirs(service_log_dir)
+    except OSError as e:
+        sys.stderr.write("launch.py: error: --log-dir: cannot create %s: %s\n" % (log_dir, e.strerror))
+        return EXIT_BAD_INPUT
+
+    console = Console(max(len(name) for name in [s.name for s in specs] + ["lcm-logger"]))
+    state = RunState()
+
+    def on_signal(signum, _frame):
+        if state.stopping:
+            # Second Ctrl-C during shutdown: do not wait out the grace period.
+            state.force_kill = True
+        elif state.stop_signal is None:
+            state.stop_signal = signum
+
+    # SIGHUP too: a dropped ssh session must stop the run cleanly (children
+    # live in their own sessions and would not see the hangup).
+    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(signum, on_signal)
+
+    env = dict(os.environ)
+    env["LCM_DEFAULT_URL"] = args.lcm_url   # services that take no --lcm-url use the same bus
+    env["PYTHONUNBUFFERED"] = "1"
+
+    # Services write to a pipe, where C stdio would buffer whole blocks and
+    # hold back crash context; stdbuf makes their output line-buffered.
+    stdbuf = shutil.which("stdbuf")
+    line_buffered = [stdbuf, "-oL", "-eL"] if stdbuf else []
+    # If the launcher itself is killed (SIGKILL, OOM) its children must not
+    # fly on as orphans: have the kernel send them SIGTERM.
+    setpriv = shutil.which("setpriv")
+    orphan_guard = [setpriv, "--pdeathsig", "TERM"] if setpriv else []
+
+    say, note = console.say, console.note
+    say("table %s, %d process%s: %s" % (_display_path(table_path), len(specs),
+                                      "" if len(specs) == 1 else "es",
+                                      ", ".join("%s@%s" % (s.name, s.host) for s in specs)))
+    say("scenario %s, rtf %s, LCM %s" % (scenario, values["rtf"], args.lcm_url))
+    pinning = Pinning(not args.no_pin, note)
+    if not stdbuf:
+        note("stdbuf not found; service output may arrive in blocks")
+
+    services = []
+    for spec in specs:
+        argv_exe = expand_command(spec, values)
+        argv_exe[0] = resolve_executable(argv_exe[0])
+        full_argv = orphan_guard + pinning.prefix(spec) + line_buffered + argv_exe
+        services.append(Child(spec.name, full_argv,
+                              os.path.join(service_log_dir, spec.name + ".log"), console, spec))
+
+    ends_run = [s for s in services if s.spec.ends_run]
+    if args.timeout > 0:
+        run_limit = args.timeout + (ENDS_RUN_TIMEOUT_GRACE_S if ends_run else 0.0)
+        say("run limit %s s%s" % (format_number(args.timeout),
+                                 " (+%g s for %s to report)" % (ENDS_RUN_TIMEOUT_GRACE_S,
+                                                               ", ".join(c.name for c in ends_run))
+                                 if ends_run else ""))
+    else:
+        run_limit = None
+        say("no run limit (--timeout 0); stop with Ctrl-C")
+    if not ends_run:
+        note("no ends_run process selected; the run ends at the time limit or on Ctrl-C")
+
+    logger = None
+    exit_code = 0
+    try:
+        if logger_exe is not None:
+            lcm_log = os.path.join(log_dir, stem + ".lcm")
+            # lcm-logger prints a throughput summary every second; keep those
+            # in its log file so they do not drown the services' output.
+            logger = Child("lcm-logger", orphan_guard + [logger_exe, "--lcm-url=" + args.lcm_url, lcm_log],
+                           os.path.join(service_log_dir, "lcm-logger.log"), console,
+                           file_only=re.compile(rb"^Summary: "))
+            if not logger.start(env):
+                return EXIT_LAUNCHER_FAILURE
+            time.sleep(LOGGER_SETTLE_S)
+            if not logger.alive():
+                logger.finish_output()
+                say("lcm-logger %s; cannot record the flight (check the LCM URL and that "
+                    "multicast is routed, or use --no-record)" % describe_exit(logger.proc.returncode)[1])
+                return EXIT_LAUNCHER_FAILURE
+            say("recording LCM traffic to %s" % lcm_log)
+            with open(os.path.join(log_dir, "latest_log"), "w") as f:
+                f.write(lcm_log + "\n")
+        else:
+            note("not recording LCM traffic (--no-record)")
+        say("service logs in %s/" % service_log_dir)
+
+        def handle_exit(child, now):
+            """Decide what a child's exit means; returns (end_reason, exit_code) or None."""
+            if child.proc is None:
+                code, text = 127, "failed to start"
+            else:
+                child.finish_output()
+                child.last_returncode = child.proc.returncode
+                code, text = describe_exit(child.proc.returncode)
+            if child.spec.ends_run:
+                child.state = Child.DONE
+                return "%s %s; it ends the run" % (child.name, text), code
+            if not child.spec.restart:
+                child.state = Child.DONE
+                say("%s %s; not restarted (restart: false)" % (child.name, text))
+            elif child.restarts >= args.max_restarts:
+                child.state = Child.DONE
+                child.gave_up = True
+                say("%s %s; GIVING UP after %d restart%s (--max-restarts %d)"
+                    % (child.name, text, child.restarts, "" if child.restarts == 1 else "s",
+                       args.max_restarts))
+            else:
+                child.restarts += 1
+                delay = min(BACKOFF_START_S * 2 ** (child.restarts - 1), BACKOFF_CAP_S)
+                child.state = Child.WAITING
+                child.restart_at = now + delay
+                say("%s %s; restarting in %g s (restart %d/%d)"
+                    % (child.name, text, delay, child.restarts, args.max_restarts))
+            return None
+
+        end_reason = None
+        for child in services:
+            if state.stop_signal is not None:
+                break
+            if not child.start(env):
+                outcome = handle_exit(child, time.monotonic())
+                if outcome is not None:
+                    end_reason, exit_code = outcome
+                    break
+        deadline = time.monotonic() + run_limit if run_limit is not None else None
+
+        logger_warned = False
+        while end_reason is None:
+            if state.stop_signal is not None:
+                end_reason = "received %s; stopping" % signal.Signals(state.stop_signal).name
+                exit_code = 128 + state.stop_signal
+                break
+            now = time.monotonic()
+            if deadline is not None and now >= deadline:
+                end_reason = "run limit of %s s reached; stopping (exit code %d)" % (
+                    format_number(args.timeout), EXIT_TIMEOUT)
+                exit_code = EXIT_TIMEOUT
+                break
+
+            for child in services:
+                outcome = None
+                if child.state == Child.RUNNING and not child.alive():
+                    outcome = handle_exit(child, now)
+                elif child.state == Child.WAITING and now >= child.restart_at:
+                    child.restart_at = None
+                    if not child.start(env):
+                        outcome = handle_exit(child, now)
+                if outcome is not None:
+                    end_reason, exit_code = outcome
+                    break
+            if end_reason is not None:
+                break
+
+            if logger is not None and not logger_warned and not logger.alive():
+                logger.finish_output()
+                say("WARNING: lcm-logger %s; the rest of this flight is NOT being recorded"
+                    % describe_exit(logger.proc.returncode)[1])
+                logger_warned = True
+
+            if all(c.state == Child.DONE for c in services):
+                end_reason = "no service left running; stopping"
+                failed = any((describe_exit(c.last_returncode)[0] or 0) != 0 or c.proc is None
+                             for c in services)
+                exit_code = 1 if failed else 0
+                break
+            time.sleep(POLL_INTERVAL_S)
+
+        say(end_reason)
+    finally:
+        # Services first (reverse start order, so consumers go before the
+        # producers they depend on), the logger last so it captures their
+        # final messages.  Always runs, so no child outlives the launcher.
+        state.stopping = True
+        stop_children(list(reversed(services)), console, state)
+        if logger is not None:
+            stop_children([logger], console, state)
+            try:
+                size_mb = os.path.getsize(lcm_log) / 1e6
+                say("flight recorded to %s (%.1f MB); replay with deploy/replay.sh %s"
+                    % (lcm_log, size_mb, _display_path(lcm_log)))
+            except OSError:
+                say("WARNING: flight log %s was not written" % lcm_log)
+        print_summary(services, console, args.max_restarts)
+    return exit_code
+
+
+def print_summary(services, console, max_restarts):
+    rows = []
+    for child in services:
+        if child.starts == 0:
+            final = "not started"
+        elif child.proc is None:
+            final = "failed to start"
+        else:
+            code, text = describe_exit(child.proc.poll())
+            final = text.replace("exited with ", "")
+            if child.stopped_by_launcher:
+                final += ", stopped by launcher"
+            elif child.gave_up and child.spec.restart:
+                final += ", gave up"
+        restarts = "%d/%d" % (child.restarts, max_restarts) if child.spec.restart else "-"
+        rows.append((child.name, child.spec.host, restarts, final))
+    width = max(len(r[0]) for r in rows)
+    host_width = max(len(r[1]) for r in rows)
+    console.say("summary:")
+    for name, host, restarts, final in rows:
+        console.say("  %s  %s  restarts %s  %s" % (name.ljust(width), host.ljust(host_width),
+                                                  restarts, final))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

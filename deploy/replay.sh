@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# Replay a recorded flight (an lcm-logger file) onto the LCM bus.
+#
+# Wraps lcm-logplayer from LCM 1.3.1, whose options are -s/--speed,
+# -e/--regexp, -l/--lcm-url and -v/--verbose.  It has no loop option, so
+# --loop is implemented here by playing the file again after each pass.
+set -euo pipefail
+
+REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+LCM_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}"
+SPEED=1.0
+LOOP=0
+CHANNELS=""
+VERBOSE=0
+LOGFILE=""
+
+usage() {
+    cat <<EOF
+usage: deploy/replay.sh LOGFILE [--speed X] [--lcm-url URL] [--loop]
+                        [--channels REGEX] [--verbose]
+
+Publishes the messages of a recorded flight on LCM with their original timing.
+
+  LOGFILE           .lcm file written by deploy/launch.py (results/flight-*.lcm),
+                    or 'latest' for the file named in results/latest_log
+  --speed X         playback speed multiplier (default 1.0; 2 = twice as fast)
+  --lcm-url URL     LCM URL to publish on
+                    (default: \$LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)
+  --loop            play the file again each time it ends (Ctrl-C to stop);
+                    message timestamps jump back at every new pass
+  --channels REGEX  replay only channels matching this GLib regular expression
+  --verbose         print every replayed message
+  -h, --help        show this help
+
+Re-running onboard software on a recorded flight: start the services under
+test alongside the replay, e.g. in a second terminal
+
+  deploy/launch.py --only mapper,global_planner --no-record --timeout 0 \\
+      --scenario <scenario of that flight>
+  deploy/replay.sh results/flight-YYYYmmdd-HHMMSS.lcm --channels '<their input channels>'
+
+Restrict --channels to the services' inputs so the recorded outputs of the
+old run do not mix with the new ones.  Watch the bus with deploy/spy.sh.
+EOF
+}
+
+die() {
+    echo "replay.sh: error: $*" >&2
+    exit 1
+}
+
+need_value() {
+    [ "$2" -ge 2 ] || { usage >&2; die "$1 needs a value"; }
+}
+
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --speed)      need_value "$1" $#; SPEED="$2"; shift 2 ;;
+        --speed=*)    SPEED="${1#*=}"; shift ;;
+        --lcm-url)    need_value "$1" $#; LCM_URL="$2"; shift 2 ;;
+        --lcm-url=*)  LCM_URL="${1#*=}"; shift ;;
+        --channels)   need_value "$1" $#; CHANNELS="$2"; shift 2 ;;
+        --channels=*) CHANNELS="${1#*=}"; shift ;;
+        --loop)       LOOP=1; shift ;;
+        --verbose|-v) VERBOSE=1; shift ;;
+        -h|--help)    usage; exit 0 ;;
+        -*)           usage >&2; die "unknown option '$1'" ;;
+        *)
+            [ -z "$LOGFILE" ] || { usage >&2; die "only one LOGFILE allowed (got '$LOGFILE' and '$1')"; }
+            LOGFILE="$1"; shift ;;
+    esac
+done
+
+[ -n "$LOGFILE" ] || { usage >&2; die "missing LOGFILE"; }
+
+if [ "$LOGFILE" = latest ]; then
+    LATEST="$REPO_ROOT/results/latest_log"
+    [ -f "$LATEST" ] || die "$LATEST not found: no flight recorded yet (run deploy/launch.py without --no-record)"
+    LOGFILE="$(head -n 1 "$LATEST")"
+fi
+[ -e "$LOGFILE" ] || die "log file '$LOGFILE' not found"
+[ -f "$LOGFILE" ] || die "'$LOGFILE' is not a regular file"
+[ -r "$LOGFILE" ] || die "log file '$LOGFILE' is not readable"
+[ -s "$LOGFILE" ] || die "log file '$LOGFILE' is empty (nothing was recorded)"
+
+# A positive decimal number; lcm-logplayer would otherwise misbehave quietly.
+[[ "$SPEED" =~ ^([0-9]+\.?[0-9]*|\.[0-9]+)$ ]] && awk -v s="$SPEED" 'BEGIN { exit !(s > 0) }' \
+    || die "--speed must be a positive number, got '$SPEED'"
+
+command -v lcm-logplayer >/dev/null 2>&1 || die "lcm-logplayer not found: apt-get install lcm"
+
+PLAYER=(lcm-logplayer "--speed=$SPEED" "--lcm-url=$LCM_URL")
+[ -z "$CHANNELS" ] || PLAYER+=("--regexp=$CHANNELS")
+[ "$VERBOSE" -eq 0 ] || PLAYER+=(--verbose)
+PLAYER+=("$LOGFILE")
+
+echo "replay.sh: replaying $LOGFILE at ${SPEED}x on $LCM_URL${CHANNELS:+ (channels /$CHANNELS/)}"
+if [ "$LOOP" -eq 0 ]; then
+    exec "${PLAYER[@]}"
+fi
+
+# Ctrl-C ends the loop rather than only the current pass.
+trap 'echo "replay.sh: stopped"; exit 130' INT TERM
+pass=1
+while true; do
+    echo "replay.sh: pass $pass"
+    "${PLAYER[@]}" || die "lcm-logplayer failed with code $? on pass $pass"
+    pass=$((pass + 1))
+done
