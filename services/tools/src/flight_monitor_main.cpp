@@ -17,7 +17,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"ofn flight monitor: progress of a live flight; exits when it is done"};
   ofn::CommonOptions options;
-  double timeout = 300.0, report_period = 5.0, linger = 2.0;
+  double timeout = 300.0, report_period = 5.0, linger = 1.0;
   ofn::add_common_options(app, options);
   app.add_option("--timeout", timeout, "give up after this many wall seconds")
       ->check(CLI::PositiveNumber);
