@@ -23,7 +23,8 @@ namespace {
 
 ofn::YamlReader config_in(const std::string& dir, const std::string& file) {
   const std::filesystem::path path = std::filesystem::path(dir) / file;
-  if (!dir.empty() && std::filesystem::exists(path)) return ofn::YamlReader::load_file(path.string());
+  if (!dir.empty() && std::filesystem::exists(path))
+    return ofn::YamlReader::load_file(path.string());
   return ofn::YamlReader::empty("(defaults)");
 }
 
@@ -78,8 +79,8 @@ int main(int argc, char** argv) {
       const ofn::Utime now = lockstep.clock().now();
       if (!quiet && ofn::to_seconds(now) >= next_progress) {
         const auto& s = vehicle.model().state();
-        std::printf("t=%6.1f s  north %8.1f m  alt %6.1f m  speed %5.2f m/s\n", ofn::to_seconds(now),
-                    s.position.x(), -s.position.z(), s.velocity.norm());
+        std::printf("t=%6.1f s  north %8.1f m  alt %6.1f m  speed %5.2f m/s\n",
+                    ofn::to_seconds(now), s.position.x(), -s.position.z(), s.velocity.norm());
         std::fflush(stdout);
         next_progress += 10.0;
       }

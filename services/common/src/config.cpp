@@ -14,8 +14,8 @@ YamlReader YamlReader::load_file(const std::string& path) {
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(path + ": line " + std::to_string(e.mark.line + 1) + ": not valid YAML: " +
-                      e.msg);
+    throw ConfigError(path + ": line " + std::to_string(e.mark.line + 1) +
+                      ": not valid YAML: " + e.msg);
   }
   if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw ConfigError(path + ": expected a mapping of fields at the top level");
@@ -39,7 +39,9 @@ void YamlReader::fail(const std::string& key, const std::string& what) const {
   throw ConfigError(s.str());
 }
 
-bool YamlReader::has(const std::string& key) const { return node_[key].IsDefined(); }
+bool YamlReader::has(const std::string& key) const {
+  return node_[key].IsDefined();
+}
 
 YAML::Node YamlReader::scalar(const std::string& key) {
   used_.insert(key);
@@ -115,7 +117,8 @@ std::vector<double> YamlReader::numbers(const std::string& key, size_t size) {
   return numbers(key, std::vector<double>(size, 0.0));
 }
 
-std::vector<double> YamlReader::numbers(const std::string& key, const std::vector<double>& fallback) {
+std::vector<double> YamlReader::numbers(const std::string& key,
+                                        const std::vector<double>& fallback) {
   used_.insert(key);
   YAML::Node n = node_[key];
   if (!n.IsDefined() || n.IsNull()) return fallback;
@@ -138,7 +141,8 @@ std::vector<double> YamlReader::numbers(const std::string& key, const std::vecto
 YamlReader YamlReader::child(const std::string& key) {
   used_.insert(key);
   YAML::Node n = node_[key];
-  if (!n.IsDefined() || n.IsNull()) return YamlReader(YAML::Node(YAML::NodeType::Map), file_, field(key));
+  if (!n.IsDefined() || n.IsNull())
+    return YamlReader(YAML::Node(YAML::NodeType::Map), file_, field(key));
   if (!n.IsMap()) fail(key, "expected a mapping of fields");
   return YamlReader(n, file_, field(key));
 }

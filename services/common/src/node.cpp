@@ -24,7 +24,8 @@ Node::Node(std::string name, lcm::LCM& lcm, const Clock& clock)
       clock_(clock),
       log_(make_logger(name_)),
       period_start_(std::chrono::steady_clock::now()) {
-  add_timer(1.0, [this] { publish_heartbeat(); }, "heartbeat");
+  add_timer(
+      1.0, [this] { publish_heartbeat(); }, "heartbeat");
 }
 
 Node::~Node() {
@@ -66,8 +67,9 @@ void Node::reject(const std::string& channel, const std::string& reason) {
   const Utime now = clock_.valid() ? clock_.now() : 0;
   if (last_reject_log_ == INT64_MIN || now - last_reject_log_ >= kMicrosPerSecond ||
       now < last_reject_log_) {
-    log_->warn("rejected {} ({} total{})", counters_.last_reject_reason, counters_.rejected,
-               suppressed_rejects_ ? ", " + std::to_string(suppressed_rejects_) + " not logged" : "");
+    log_->warn(
+        "rejected {} ({} total{})", counters_.last_reject_reason, counters_.rejected,
+        suppressed_rejects_ ? ", " + std::to_string(suppressed_rejects_) + " not logged" : "");
     last_reject_log_ = now;
     suppressed_rejects_ = 0;
   } else {
@@ -88,7 +90,8 @@ void Node::add_timer(double period, std::function<void()> callback, std::string 
 
 Utime Node::next_deadline() const {
   Utime next = INT64_MAX;
-  for (const auto& t : timers_) next = std::min(next, t.deadline == INT64_MIN ? INT64_MIN : t.deadline);
+  // An unscheduled timer (INT64_MIN) is due at once.
+  for (const auto& t : timers_) next = std::min(next, t.deadline);
   return next;
 }
 

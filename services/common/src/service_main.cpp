@@ -15,15 +15,18 @@ namespace ofn {
 namespace {
 
 std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop.store(true); }
+void on_signal(int) {
+  g_stop.store(true);
+}
 
 }  // namespace
 
-void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock) {
+void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock, bool with_config) {
   // A bad command line prints the whole usage, not just the complaint.
   app.failure_message(CLI::FailureMessage::help);
-  app.add_option("--config", options.config, "service configuration file (YAML)")
-      ->check(CLI::ExistingFile);
+  if (with_config)
+    app.add_option("--config", options.config, "service configuration file (YAML)")
+        ->check(CLI::ExistingFile);
   app.add_option("--lcm-url", options.lcm_url,
                  "LCM URL (default: $LCM_DEFAULT_URL or " + std::string(kDefaultLcmUrl) + ")");
   if (with_clock)

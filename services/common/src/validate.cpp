@@ -15,8 +15,9 @@ bool within_world(const double (&p)[3]) {
 
 std::string check_count(int32_t count, size_t actual, int32_t max, const char* what) {
   if (count < 0) return std::string("negative ") + what + " count";
-  if (count > max) return std::string("too many ") + what + " (" + std::to_string(count) + " > " +
-                          std::to_string(max) + ")";
+  if (count > max)
+    return std::string("too many ") + what + " (" + std::to_string(count) + " > " +
+           std::to_string(max) + ")";
   if (static_cast<size_t>(count) != actual) return std::string(what) + " count does not match";
   return "";
 }
@@ -30,11 +31,13 @@ std::string check_frame(const std::string& frame) {
 std::string validate(const nav_state_t& m) {
   if (auto e = check_frame(m.frame); !e.empty()) return e;
   if (!within_world(m.position)) return "position not finite or out of range";
-  if (!all_finite(m.velocity) || !all_finite(m.acceleration)) return "velocity/acceleration not finite";
+  if (!all_finite(m.velocity) || !all_finite(m.acceleration))
+    return "velocity/acceleration not finite";
   if (!all_finite(m.quaternion) || !all_finite(m.euler) || !all_finite(m.body_rates))
     return "attitude not finite";
-  const double qn = std::sqrt(m.quaternion[0] * m.quaternion[0] + m.quaternion[1] * m.quaternion[1] +
-                              m.quaternion[2] * m.quaternion[2] + m.quaternion[3] * m.quaternion[3]);
+  const double qn =
+      std::sqrt(m.quaternion[0] * m.quaternion[0] + m.quaternion[1] * m.quaternion[1] +
+                m.quaternion[2] * m.quaternion[2] + m.quaternion[3] * m.quaternion[3]);
   if (std::abs(qn - 1.0) > 1e-3) return "quaternion not normalised";
   return "";
 }
@@ -60,10 +63,11 @@ std::string validate(const mission_t& m) {
       !e.empty())
     return e;
   const auto& l = m.limits;
-  const double lim[6] = {l.max_speed, l.max_accel, l.max_vertical_speed, l.min_forward_speed,
-                         l.clearance, l.sensor_range};
+  const double lim[6] = {l.max_speed,         l.max_accel, l.max_vertical_speed,
+                         l.min_forward_speed, l.clearance, l.sensor_range};
   if (!all_finite(lim)) return "limits not finite";
-  if (l.max_speed <= 0 || l.max_accel <= 0 || l.max_vertical_speed <= 0) return "limits not positive";
+  if (l.max_speed <= 0 || l.max_accel <= 0 || l.max_vertical_speed <= 0)
+    return "limits not positive";
   if (l.clearance < 0 || l.sensor_range < 0) return "negative clearance or sensor range";
   if (!(m.cruise_speed > 0) || m.cruise_speed > l.max_speed * (1 + 1e-9))
     return "cruise speed not in (0, max_speed]";
@@ -126,8 +130,8 @@ std::string validate(const obstacle_grid_t& m) {
   if (auto e = check_frame(m.frame); !e.empty()) return e;
   if (m.rows <= 0 || m.cols <= 0) return "grid dimensions not positive";
   if (static_cast<int64_t>(m.rows) * m.cols != m.num_cells) return "cell count != rows * cols";
-  if (auto e = check_count(m.num_cells, m.top_altitude.size(), MessageLimits::kMaxGridCells,
-                           "cells");
+  if (auto e =
+          check_count(m.num_cells, m.top_altitude.size(), MessageLimits::kMaxGridCells, "cells");
       !e.empty())
     return e;
   if (!(m.resolution > 0) || !std::isfinite(m.resolution)) return "resolution not positive";

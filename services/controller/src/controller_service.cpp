@@ -7,8 +7,12 @@
 namespace ofn::control {
 namespace {
 
-Vec3 vec(const double (&a)[3]) { return Vec3(a[0], a[1], a[2]); }
-Vec3 vec(const std::vector<double>& a) { return Vec3(a[0], a[1], a[2]); }
+Vec3 vec(const double (&a)[3]) {
+  return Vec3(a[0], a[1], a[2]);
+}
+Vec3 vec(const std::vector<double>& a) {
+  return Vec3(a[0], a[1], a[2]);
+}
 void put(double (&dst)[3], const Vec3& v) {
   for (int i = 0; i < 3; ++i) dst[i] = v[i];
 }
@@ -47,16 +51,19 @@ ControllerConfig load_controller_config(YamlReader& r) {
       inner.number_in("integral_limit", c.gains.attitude_integral_limit, 0.0, 100.0);
   inner.finish();
   YamlReader guidance = r.child("guidance");
-  c.guidance.accel_fraction = guidance.number_in("accel_fraction", c.guidance.accel_fraction, 0.05, 1.0);
+  c.guidance.accel_fraction =
+      guidance.number_in("accel_fraction", c.guidance.accel_fraction, 0.05, 1.0);
   c.guidance.speed_gain = guidance.number_in("speed_gain", c.guidance.speed_gain, 0.05, 20.0);
-  c.guidance.jerk_fraction = guidance.number_in("jerk_fraction", c.guidance.jerk_fraction, 0.05, 100.0);
+  c.guidance.jerk_fraction =
+      guidance.number_in("jerk_fraction", c.guidance.jerk_fraction, 0.05, 100.0);
   c.guidance.max_lead = guidance.number_in("max_lead", c.guidance.max_lead, 0.1, 1000.0);
   c.guidance.stop_speed = guidance.number_in("stop_speed", c.guidance.stop_speed, 0.01, 10.0);
   guidance.finish();
   YamlReader sweep = r.child("yaw_sweep");
   c.sweep.enabled = sweep.boolean("enabled", c.sweep.enabled);
   c.sweep.frequency = sweep.number_in("frequency_hz", c.sweep.frequency, 0.01, 5.0);
-  c.sweep.total_angle = deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
+  c.sweep.total_angle =
+      deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
   sweep.finish();
   YamlReader nominal = r.child("nominal_airframe");
   c.nominal.mass = nominal.number_in("mass", c.nominal.mass, 1.0, 1e4);
@@ -69,8 +76,8 @@ std::optional<Reference> sample_ref_traj(const ref_traj_t& traj, Utime now) {
   const double t = to_seconds(now - traj.t0_utime);
   const auto& ts = traj.sample_time;
   if (ts.size() < 2 || t < ts.front() || t > ts.back()) return std::nullopt;
-  const size_t i = std::min<size_t>(
-      ts.size() - 2, std::upper_bound(ts.begin(), ts.end(), t) - ts.begin() - 1);
+  const size_t i =
+      std::min<size_t>(ts.size() - 2, std::upper_bound(ts.begin(), ts.end(), t) - ts.begin() - 1);
   const double f = (t - ts[i]) / (ts[i + 1] - ts[i]);
   auto lerp = [&](const std::vector<std::vector<double>>& v) -> Vec3 {
     return (1.0 - f) * vec(v[i]) + f * vec(v[i + 1]);
@@ -92,12 +99,15 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
       SubscribeOptions{config_.nav_timeout, 0.5});
   // A plan is not state: it stays valid however old its stamp is.
   node_.subscribe<mission_t>(
-      channels::kMission, [this](const mission_t& m) { on_mission(m); }, SubscribeOptions{0.0, 0.0});
+      channels::kMission, [this](const mission_t& m) { on_mission(m); },
+      SubscribeOptions{0.0, 0.0});
   node_.subscribe<ref_traj_t>(
       channels::kRefTraj, [this](const ref_traj_t& m) { on_ref_traj(m); },
       SubscribeOptions{config_.ref_traj_timeout, 0.5});
-  node_.add_timer(1.0 / config_.rate, [this] { control_step(); }, "control");
-  node_.add_timer(1.0 / config_.status_rate, [this] { publish_status(); }, "status");
+  node_.add_timer(
+      1.0 / config_.rate, [this] { control_step(); }, "control");
+  node_.add_timer(
+      1.0 / config_.status_rate, [this] { publish_status(); }, "status");
 }
 
 void ControllerService::on_mission(const mission_t& m) {
@@ -156,8 +166,9 @@ void ControllerService::control_step() {
   VehicleEstimate x;
   x.position = vec(nav_->position);
   x.velocity = vec(nav_->velocity);
-  x.attitude = Quat(nav_->quaternion[0], nav_->quaternion[1], nav_->quaternion[2],
-                    nav_->quaternion[3]).normalized();
+  x.attitude =
+      Quat(nav_->quaternion[0], nav_->quaternion[1], nav_->quaternion[2], nav_->quaternion[3])
+          .normalized();
   x.body_rates = vec(nav_->body_rates);
   if (!path_yaw_set_) {
     path_yaw_ = nav_->euler[2];
@@ -167,9 +178,9 @@ void ControllerService::control_step() {
   if (mission_pending_) {
     std::vector<Waypoint> wps;
     for (const auto& w : mission_->waypoints) wps.push_back({vec(w.position), w.capture_radius});
-    Limits lim{mission_->limits.max_speed, mission_->limits.max_accel,
+    Limits lim{mission_->limits.max_speed,          mission_->limits.max_accel,
                mission_->limits.max_vertical_speed, mission_->limits.min_forward_speed,
-               mission_->limits.clearance, mission_->limits.sensor_range};
+               mission_->limits.clearance,          mission_->limits.sensor_range};
     guidance_.set_mission(wps, mission_->cruise_speed, lim, x.position, x.velocity);
     mission_pending_ = false;
   }

@@ -59,7 +59,8 @@ double TrajectoryController::collective_for_thrust(double thrust, const Vec3& ai
   return (2.0 * ct / (p.lift_slope * p.solidity) + 0.5 * lambda) / (1.0 / 3.0 + 0.5 * mu * mu);
 }
 
-ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEstimate& x, double dt) {
+ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEstimate& x,
+                                         double dt) {
   const auto& p = model_.params();
   const auto& g = gains_;
   ControlOutput out;
@@ -75,7 +76,8 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
     // Anti-windup: integrate only near the reference (large errors are the
     // proportional term's job, and winding up on them overshoots), and keep
     // the integral's share within its limit.
-    if (std::abs(ad.position_error[i]) < g.integral_band) position_integral_[i] += ad.position_error[i] * dt;
+    if (std::abs(ad.position_error[i]) < g.integral_band)
+      position_integral_[i] += ad.position_error[i] * dt;
     if (g.integral[i] > 0)
       position_integral_[i] = std::clamp(position_integral_[i], -g.integral_limit / g.integral[i],
                                          g.integral_limit / g.integral[i]);
@@ -87,8 +89,8 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   Vec3 accel = ad.pseudo_accel - out.adaptive_accel;
   const Vec3 horizontal = clamp_norm(Vec3(accel.x(), accel.y(), 0.0), g.max_horizontal_accel);
   const double vertical = std::clamp(accel.z(), -g.max_vertical_accel, g.max_vertical_accel);
-  out.saturated = (horizontal - Vec3(accel.x(), accel.y(), 0.0)).norm() > 1e-9 ||
-                  vertical != accel.z();
+  out.saturated =
+      (horizontal - Vec3(accel.x(), accel.y(), 0.0)).norm() > 1e-9 || vertical != accel.z();
   accel = Vec3(horizontal.x(), horizontal.y(), vertical);
   out.commanded_accel = accel;
 
@@ -96,8 +98,8 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   // the tail rotor's side force (last step's value; it changes slowly).
   const Mat3 world_from_body = x.attitude.toRotationMatrix();
   const Vec3 air_body = world_from_body.transpose() * x.velocity;
-  const Vec3 drag_body = -0.5 * p.air_density *
-                         p.drag_area.cwiseProduct(air_body.cwiseAbs()).cwiseProduct(air_body);
+  const Vec3 drag_body =
+      -0.5 * p.air_density * p.drag_area.cwiseProduct(air_body.cwiseAbs()).cwiseProduct(air_body);
   const Vec3 other_body = drag_body + Vec3(0.0, tail_thrust_estimate_, 0.0);
   Vec3 force = p.mass * (accel - Vec3(0, 0, kGravity)) - world_from_body * other_body;
   // Never ask for less than a fraction of hover thrust or a large tilt.
@@ -145,10 +147,10 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   const double flap_lon = -moment.y() / moment_per_flap;
   // The disk settles at the cyclic command less blow-back, shifted by the
   // gyroscopic lag under body rates; invert that steady relation.
-  out.controls.lon_cyclic = (flap_lon - p.flap_time_constant * w.y() + p.flap_blowback * air_body.x()) /
-                            p.cyclic_to_flap;
-  out.controls.lat_cyclic = (flap_lat + p.flap_time_constant * w.x() + p.flap_blowback * air_body.y()) /
-                            p.cyclic_to_flap;
+  out.controls.lon_cyclic =
+      (flap_lon - p.flap_time_constant * w.y() + p.flap_blowback * air_body.x()) / p.cyclic_to_flap;
+  out.controls.lat_cyclic =
+      (flap_lat + p.flap_time_constant * w.x() + p.flap_blowback * air_body.y()) / p.cyclic_to_flap;
   // Yaw: tail thrust balances main-rotor torque and supplies the moment.
   vehicle::RotorcraftState probe;
   probe.attitude = x.attitude;

@@ -28,7 +28,8 @@ void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, doubl
   if (waypoints_.size() > 1) {
     double best_distance = std::numeric_limits<double>::infinity();
     for (size_t i = 1; i < waypoints_.size(); ++i) {
-      const double d = distance_to_segment(position, waypoints_[i - 1].position, waypoints_[i].position);
+      const double d =
+          distance_to_segment(position, waypoints_[i - 1].position, waypoints_[i].position);
       if (d <= best_distance) {  // ties go to the later leg
         best_distance = d;
         best = static_cast<int>(i);
@@ -82,7 +83,8 @@ GuidanceReference WaypointGuidance::update(const Vec3& position, const Vec3& vel
     const Vec3 ref_point = leg_start_ + leg_dir_ * s_;
     const Vec3 next = waypoints_[active_ + 1].position - ref_point;
     // Keep the part of the speed that lies along the new leg.
-    const double carried = next.norm() > 1e-9 ? s_dot_ * std::max(0.0, leg_dir_.dot(next.normalized())) : 0.0;
+    const double carried =
+        next.norm() > 1e-9 ? s_dot_ * std::max(0.0, leg_dir_.dot(next.normalized())) : 0.0;
     start_leg(ref_point, active_ + 1, carried);
   }
 

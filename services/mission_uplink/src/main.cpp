@@ -9,7 +9,7 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn mission_uplink: publishes a scenario's waypoint plan as MISSION"};
   ofn::CommonOptions options;
   std::string scenario_path;
-  ofn::add_common_options(app, options);
+  ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")->required();
   CLI11_PARSE(app, argc, argv);
 

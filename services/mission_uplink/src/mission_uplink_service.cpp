@@ -36,7 +36,8 @@ MissionUplinkService::MissionUplinkService(lcm::LCM& lcm, const Clock& clock,
   mission_ = mission_from_scenario(load_scenario(path_), 1);
   loaded_mtime_ = std::filesystem::last_write_time(path_);
   node_.set_state("running");
-  node_.add_timer(1.0, [this] { tick(); }, "uplink");
+  node_.add_timer(
+      1.0, [this] { tick(); }, "uplink");
 }
 
 void MissionUplinkService::reload_if_changed() {

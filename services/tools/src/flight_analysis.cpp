@@ -14,8 +14,7 @@ std::optional<double> crossing_time(const std::vector<NavSample>& nav, double x)
       return nav[i - 1].t + f * (nav[i].t - nav[i - 1].t);
     }
   }
-  if (!nav.empty() && nav.front().position.x() >= x) return std::nullopt;  // started past it
-  return std::nullopt;
+  return std::nullopt;  // never crossed, or started past the line
 }
 
 FlightSummary analyse_flight(const std::vector<NavSample>& nav,
@@ -49,7 +48,8 @@ FlightSummary analyse_flight(const std::vector<NavSample>& nav,
     ++count;
   }
   if (count) s.tracking_rms = std::sqrt(sum_sq / static_cast<double>(count));
-  if (limits.max_accel > 0) s.max_commanded_accel_fraction = s.max_commanded_accel / limits.max_accel;
+  if (limits.max_accel > 0)
+    s.max_commanded_accel_fraction = s.max_commanded_accel / limits.max_accel;
   return s;
 }
 

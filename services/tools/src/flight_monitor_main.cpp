@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn flight monitor: progress of a live flight; exits when it is done"};
   ofn::CommonOptions options;
   double timeout = 300.0, report_period = 5.0, linger = 1.0;
-  ofn::add_common_options(app, options);
+  ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
   app.add_option("--timeout", timeout, "give up after this many wall seconds")
       ->check(CLI::PositiveNumber);
   app.add_option("--every", report_period, "seconds of flight time between progress lines")
@@ -45,22 +45,28 @@ int main(int argc, char** argv) {
           }
           mode = m.mode;
         });
-    node.add_timer(report_period, [&] {
-      if (!nav) {
-        std::cout << "monitor: waiting for NAV_STATE" << std::endl;
-        return;
-      }
-      const double speed = std::hypot(nav->velocity[0], nav->velocity[1], nav->velocity[2]);
-      std::printf("monitor: t=%6.1f s  north %8.1f m  east %6.1f m  alt %6.1f m  speed %5.2f m/s  mode %d\n",
-                  ofn::to_seconds(nav->utime), nav->position[0], nav->position[1], -nav->position[2],
-                  speed, static_cast<int>(mode));
-      std::fflush(stdout);
-    }, "progress");
+    node.add_timer(
+        report_period,
+        [&] {
+          if (!nav) {
+            std::cout << "monitor: waiting for NAV_STATE" << std::endl;
+            return;
+          }
+          const double speed = std::hypot(nav->velocity[0], nav->velocity[1], nav->velocity[2]);
+          std::printf(
+              "monitor: t=%6.1f s  north %8.1f m  east %6.1f m  alt %6.1f m  speed %5.2f m/s  mode "
+              "%d\n",
+              ofn::to_seconds(nav->utime), nav->position[0], nav->position[1], -nav->position[2],
+              speed, static_cast<int>(mode));
+          std::fflush(stdout);
+        },
+        "progress");
     const auto wall_start = std::chrono::steady_clock::now();
     bool timed_out = false;
     ofn::run_nodes(*lcm, *clock, {&node}, [&] {
       if (done_at != INT64_MIN && clock->now() - done_at >= ofn::to_utime(linger)) return false;
-      timed_out = std::chrono::steady_clock::now() - wall_start > std::chrono::duration<double>(timeout);
+      timed_out =
+          std::chrono::steady_clock::now() - wall_start > std::chrono::duration<double>(timeout);
       return !timed_out;
     });
     if (timed_out) {

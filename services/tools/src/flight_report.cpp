@@ -20,7 +20,9 @@
 namespace ofn::report {
 namespace {
 
-Vec3 vec(const double (&a)[3]) { return Vec3(a[0], a[1], a[2]); }
+Vec3 vec(const double (&a)[3]) {
+  return Vec3(a[0], a[1], a[2]);
+}
 
 template <class Msg>
 bool decode(const lcm::LogEvent& e, Msg& out) {
@@ -58,8 +60,8 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   std::optional<Utime> t0;
   auto rel = [&](Utime t) { return to_seconds(t - *t0); };
 
-  auto nav_csv = open_csv(out / "nav_state.csv",
-                          "t,north,east,down,vn,ve,vd,an,ae,ad,roll,pitch,yaw,p,q,r");
+  auto nav_csv =
+      open_csv(out / "nav_state.csv", "t,north,east,down,vn,ve,vd,an,ae,ad,roll,pitch,yaw,p,q,r");
   auto status_csv = open_csv(out / "control_status.csv",
                              "t,mode,mission_id,active_waypoint,ref_n,ref_e,ref_d,ref_vn,ref_ve,"
                              "ref_vd,ref_an,ref_ae,ref_ad,cmd_an,cmd_ae,cmd_ad,err_n,err_e,err_d,"
@@ -155,7 +157,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
 
   Limits limits;
   if (mission) {
-    limits = {mission->limits.max_speed,         mission->limits.max_accel,
+    limits = {mission->limits.max_speed,          mission->limits.max_accel,
               mission->limits.max_vertical_speed, mission->limits.min_forward_speed,
               mission->limits.clearance,          mission->limits.sensor_range};
     auto wp_csv = open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
@@ -209,7 +211,8 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     << " s of navigation data)\n";
   t << "  result            : "
     << (s.reached_last_waypoint ? "reached the last waypoint" : "did NOT reach the last waypoint");
-  if (finish_gate) t << (s.crossed_finish ? ", crossed the finish gate" : ", did NOT cross the finish gate");
+  if (finish_gate)
+    t << (s.crossed_finish ? ", crossed the finish gate" : ", did NOT cross the finish gate");
   t << "\n";
   if (s.gate_to_gate)
     t << "  gate-to-gate time : " << *s.gate_to_gate << " s (x = " << *start_gate / k << " -> "
@@ -218,14 +221,16 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     t << "  gate-to-gate time : n/a (a gate was not crossed)\n";
   t << "  max speed         : " << s.max_speed / k << " " << unit << "/s (limit "
     << limits.max_speed / k << ")\n";
-  t << "  max commanded acc : " << s.max_commanded_accel / k << " " << unit << "/s^2 = "
-    << std::setprecision(0) << 100.0 * s.max_commanded_accel_fraction << std::setprecision(2)
-    << " % of the " << limits.max_accel / k << " " << unit << "/s^2 limit\n";
+  t << "  max commanded acc : " << s.max_commanded_accel / k << " " << unit
+    << "/s^2 = " << std::setprecision(0) << 100.0 * s.max_commanded_accel_fraction
+    << std::setprecision(2) << " % of the " << limits.max_accel / k << " " << unit
+    << "/s^2 limit\n";
   t << "  max pseudo-control: " << s.max_pseudo_control / k << " " << unit
     << "/s^2 (command plus feedback corrections)\n";
   t << "  tracking error    : RMS " << s.tracking_rms / k << " " << unit << ", max "
     << s.tracking_max / k << " " << unit << "\n";
-  if (result.undecodable) t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
+  if (result.undecodable)
+    t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
   t << "  files             : " << out.string() << "/{nav_state,control_status,actuator_cmd,"
     << "heartbeats,waypoints}.csv, summary.json\n";
   result.text = t.str();

@@ -111,8 +111,8 @@ RotorcraftDerivative RotorcraftModel::derivative(const RotorcraftState& s, const
   const double tail_side_flow = air_body.y() - w.z() * p.tail_arm;
   loads.tail_thrust = -p.tail_thrust_per_rad * act.pedal - p.tail_velocity_damping * tail_side_flow;
 
-  const Vec3 drag = -0.5 * p.air_density *
-                    p.drag_area.cwiseProduct(air_body.cwiseAbs()).cwiseProduct(air_body);
+  const Vec3 drag =
+      -0.5 * p.air_density * p.drag_area.cwiseProduct(air_body.cwiseAbs()).cwiseProduct(air_body);
   loads.force_body = rotor_force + Vec3(0.0, loads.tail_thrust, 0.0) + drag;
   loads.moment_body = Vec3(p.hub_height * rotor_force.y() + p.flap_stiffness * s.flap_lat,
                            -p.hub_height * rotor_force.x() - p.flap_stiffness * s.flap_lon,
@@ -130,8 +130,8 @@ RotorcraftDerivative RotorcraftModel::derivative(const RotorcraftState& s, const
   const auto target = clamp_controls(command, p).as_array();
   const auto now = act.as_array();
   for (int i = 0; i < 4; ++i)
-    d.actuator_dot[i] = std::clamp((target[i] - now[i]) / p.servo_time_constant, -p.actuator_rate,
-                                   p.actuator_rate);
+    d.actuator_dot[i] =
+        std::clamp((target[i] - now[i]) / p.servo_time_constant, -p.actuator_rate, p.actuator_rate);
   if (loads_out) *loads_out = loads;
   return d;
 }

@@ -23,7 +23,8 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
   p.flap_time_constant = airframe.number_in("flap_time_constant", p.flap_time_constant, 0.01, 2.0);
   p.inflow_time_constant =
       airframe.number_in("inflow_time_constant", p.inflow_time_constant, 0.01, 2.0);
-  p.servo_time_constant = airframe.number_in("servo_time_constant", p.servo_time_constant, 0.001, 1.0);
+  p.servo_time_constant =
+      airframe.number_in("servo_time_constant", p.servo_time_constant, 0.001, 1.0);
   p.actuator_rate = airframe.number_in("actuator_rate", p.actuator_rate, 0.01, 100.0);
   airframe.finish();
   r.finish();
@@ -48,11 +49,12 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
   model_.set_state(start_state_);
   model_.set_command(trim_controls_);
   released_ = !config_.hold_until_engaged;
-  node_.log().info("start trim: collective {:.3f} lon {:.3f} lat {:.3f} pedal {:.3f} rad, "
-                   "pitch {:.2f} roll {:.2f} deg",
-                   t.controls.collective, t.controls.lon_cyclic, t.controls.lat_cyclic,
-                   t.controls.pedal, rad2deg(euler_from_quat(t.state.attitude).y()),
-                   rad2deg(euler_from_quat(t.state.attitude).x()));
+  node_.log().info(
+      "start trim: collective {:.3f} lon {:.3f} lat {:.3f} pedal {:.3f} rad, "
+      "pitch {:.2f} roll {:.2f} deg",
+      t.controls.collective, t.controls.lon_cyclic, t.controls.lat_cyclic, t.controls.pedal,
+      rad2deg(euler_from_quat(t.state.attitude).y()),
+      rad2deg(euler_from_quat(t.state.attitude).x()));
 
   node_.subscribe<actuator_cmd_t>(
       channels::kActuatorCmd, [this](const actuator_cmd_t& m) { on_command(m); },
@@ -60,8 +62,10 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
   node_.subscribe<control_status_t>(
       channels::kControlStatus, [this](const control_status_t& m) { on_control_status(m); },
       SubscribeOptions{1.0, 1.0});
-  node_.add_timer(1.0 / config_.physics_rate, [this] { step_physics(); }, "physics");
-  node_.add_timer(1.0 / config_.nav_rate, [this] { publish_nav(); }, "nav");
+  node_.add_timer(
+      1.0 / config_.physics_rate, [this] { step_physics(); }, "physics");
+  node_.add_timer(
+      1.0 / config_.nav_rate, [this] { publish_nav(); }, "nav");
 }
 
 void VehicleSimService::on_command(const actuator_cmd_t& m) {

@@ -15,8 +15,12 @@ namespace ofn {
 using Utime = int64_t;
 
 constexpr Utime kMicrosPerSecond = 1000000;
-inline double to_seconds(Utime t) { return static_cast<double>(t) * 1e-6; }
-inline Utime to_utime(double seconds) { return static_cast<Utime>(seconds * 1e6 + (seconds >= 0 ? 0.5 : -0.5)); }
+inline double to_seconds(Utime t) {
+  return static_cast<double>(t) * 1e-6;
+}
+inline Utime to_utime(double seconds) {
+  return static_cast<Utime>(seconds * 1e6 + (seconds >= 0 ? 0.5 : -0.5));
+}
 
 class Clock {
  public:

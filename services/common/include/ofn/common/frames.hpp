@@ -15,12 +15,16 @@ using Vec3 = Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;
 using Mat3 = Eigen::Matrix3d;
 
-constexpr double kGravity = 9.80665;     // m/s^2
+constexpr double kGravity = 9.80665;  // m/s^2
 constexpr double kMetresPerFoot = 0.3048;
 constexpr double kPi = 3.14159265358979323846;
 
-inline double deg2rad(double d) { return d * kPi / 180.0; }
-inline double rad2deg(double r) { return r * 180.0 / kPi; }
+inline double deg2rad(double d) {
+  return d * kPi / 180.0;
+}
+inline double rad2deg(double r) {
+  return r * 180.0 / kPi;
+}
 
 /// Wraps an angle to (-pi, pi].
 inline double wrap_angle(double a) {
@@ -46,8 +50,12 @@ inline Vec3 euler_from_quat(const Quat& q) {
 
 /// Course frame (x along the course, y right, h up) to NED, both in metres.
 /// The benchmarks lay the course along north.
-inline Vec3 course_to_ned(const Vec3& course) { return Vec3(course.x(), course.y(), -course.z()); }
-inline Vec3 ned_to_course(const Vec3& ned) { return Vec3(ned.x(), ned.y(), -ned.z()); }
+inline Vec3 course_to_ned(const Vec3& course) {
+  return Vec3(course.x(), course.y(), -course.z());
+}
+inline Vec3 ned_to_course(const Vec3& ned) {
+  return Vec3(ned.x(), ned.y(), -ned.z());
+}
 
 /// Guidance frame of a leg (paper Fig. 4): x from the previous to the next
 /// waypoint, y to its right, z completing a right-handed set (down for a

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include "ofn/common/clock.hpp"
 #include "ofn/common/validate.hpp"

@@ -20,13 +20,16 @@ namespace ofn {
 inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 
 struct CommonOptions {
-  std::string config;      // service config file (YAML); empty: defaults
-  std::string lcm_url;     // empty: $LCM_DEFAULT_URL or kDefaultLcmUrl
+  std::string config;   // service config file (YAML); empty: defaults
+  std::string lcm_url;  // empty: $LCM_DEFAULT_URL or kDefaultLcmUrl
   std::string clock = "wall";
   std::string log_level = "info";
 };
 
-void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock = true);
+/// Adds --lcm-url and --log-level, and --clock / --config for programs that
+/// have a clock choice or a config file.
+void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock = true,
+                        bool with_config = true);
 
 /// Applies the log level and opens the LCM handle; throws with a clear
 /// message if the URL cannot be opened.

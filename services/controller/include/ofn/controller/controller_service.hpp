@@ -18,7 +18,7 @@ namespace ofn::control {
 
 struct YawSweep {
   bool enabled = false;
-  double frequency = 0.2;          // Hz
+  double frequency = 0.2;            // Hz
   double total_angle = deg2rad(40);  // rad, peak to peak
 };
 

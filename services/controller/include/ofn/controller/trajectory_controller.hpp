@@ -33,26 +33,26 @@ struct VehicleEstimate {
 
 struct ControllerGains {
   // Outer loop per world axis (north, east, down).
-  Vec3 position = Vec3(0.64, 0.64, 1.0);      // 1/s^2
-  Vec3 velocity = Vec3(1.44, 1.44, 1.8);      // 1/s
-  Vec3 integral = Vec3(0.04, 0.04, 0.1);      // 1/s^3
-  double integral_limit = 1.0;                // m/s^2, largest integral share
-  double integral_band = 1.0;                 // m, integrate only errors smaller than this
-  double max_horizontal_accel = 3.0;          // m/s^2, pseudo-control bound
-  double max_vertical_accel = 3.0;            // m/s^2
-  double max_tilt = deg2rad(25.0);            // rad
+  Vec3 position = Vec3(0.64, 0.64, 1.0);  // 1/s^2
+  Vec3 velocity = Vec3(1.44, 1.44, 1.8);  // 1/s
+  Vec3 integral = Vec3(0.04, 0.04, 0.1);  // 1/s^3
+  double integral_limit = 1.0;            // m/s^2, largest integral share
+  double integral_band = 1.0;             // m, integrate only errors smaller than this
+  double max_horizontal_accel = 3.0;      // m/s^2, pseudo-control bound
+  double max_vertical_accel = 3.0;        // m/s^2
+  double max_tilt = deg2rad(25.0);        // rad
   // Inner loop per body axis (roll, pitch, yaw).
-  Vec3 attitude = Vec3(9.0, 9.0, 4.0);        // 1/s^2
-  Vec3 rate = Vec3(4.8, 4.8, 4.0);            // 1/s
+  Vec3 attitude = Vec3(9.0, 9.0, 4.0);           // 1/s^2
+  Vec3 rate = Vec3(4.8, 4.8, 4.0);               // 1/s
   Vec3 attitude_integral = Vec3(2.0, 2.0, 1.0);  // 1/s^3
-  double attitude_integral_limit = 2.0;       // rad/s^2
+  double attitude_integral_limit = 2.0;          // rad/s^2
 };
 
 /// Inputs an adaptive element sees each step.
 struct AdaptiveInputs {
-  Vec3 position_error, velocity_error;     // reference - actual, world
-  Vec3 attitude_error, rate_error;         // body
-  Vec3 pseudo_accel, pseudo_angular;       // pseudo-controls before the adaptive share
+  Vec3 position_error, velocity_error;  // reference - actual, world
+  Vec3 attitude_error, rate_error;      // body
+  Vec3 pseudo_accel, pseudo_angular;    // pseudo-controls before the adaptive share
   Vec3 velocity, body_rates;
   double dt = 0;
 };
@@ -80,12 +80,12 @@ class NoAdaptation final : public AdaptiveElement {
 
 struct ControlOutput {
   vehicle::Controls controls;
-  Vec3 commanded_accel = Vec3::Zero();   // outer-loop pseudo-control, world NED
-  Vec3 adaptive_accel = Vec3::Zero();    // adaptive share of it
+  Vec3 commanded_accel = Vec3::Zero();  // outer-loop pseudo-control, world NED
+  Vec3 adaptive_accel = Vec3::Zero();   // adaptive share of it
   Quat attitude_command = Quat::Identity();
-  double thrust = 0;                     // N
-  bool saturated = false;                // an actuator or pseudo-control bound was hit
-  bool valid = true;                     // false: non-finite result replaced by a safe command
+  double thrust = 0;       // N
+  bool saturated = false;  // an actuator or pseudo-control bound was hit
+  bool valid = true;       // false: non-finite result replaced by a safe command
 };
 
 class TrajectoryController {

@@ -25,8 +25,8 @@ struct GuidanceReference {
   Vec3 velocity = Vec3::Zero();
   Vec3 acceleration = Vec3::Zero();
   Vec3 leg_direction = Vec3::UnitX();  // unit vector of the active leg
-  int active_waypoint = -1;             // index of the waypoint flown to; -1 without mission
-  bool done = false;                    // arrived at the last waypoint
+  int active_waypoint = -1;            // index of the waypoint flown to; -1 without mission
+  bool done = false;                   // arrived at the last waypoint
 };
 
 class WaypointGuidance {

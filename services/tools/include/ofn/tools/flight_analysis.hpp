@@ -31,8 +31,8 @@ struct FlightSummary {
   bool crossed_finish = false;
   std::optional<double> gate_start_time, gate_finish_time;  // s
   std::optional<double> gate_to_gate;                       // s
-  double max_speed = 0;                // m/s, whole flight
-  double max_vertical_speed = 0;       // m/s
+  double max_speed = 0;                                     // m/s, whole flight
+  double max_vertical_speed = 0;                            // m/s
   /// m/s^2, largest |acceleration| the trajectory source (waypoint guidance
   /// or the RH optimiser) commanded while the plan was flown: the quantity
   /// the planners' acceleration limit applies to (paper Eq. 8).
@@ -41,8 +41,8 @@ struct FlightSummary {
   /// m/s^2, largest |outer-loop pseudo-control|: the command plus the
   /// controller's feedback corrections.
   double max_pseudo_control = 0;
-  double tracking_rms = 0;             // m, |reference - actual| while flying the plan
-  double tracking_max = 0;             // m
+  double tracking_rms = 0;  // m, |reference - actual| while flying the plan
+  double tracking_max = 0;  // m
 };
 
 /// Time at which the north coordinate first reaches `x` (linear

@@ -35,27 +35,27 @@ struct Controls {
 /// small-helicopter identification results (Mettler et al.), not an
 /// identified model of any airframe. docs/VEHICLE_MODEL.md lists them.
 struct RotorcraftParams {
-  double mass = 80.0;                       // kg (airframe + avionics + fuel)
-  Vec3 inertia = Vec3(8.0, 22.0, 18.0);     // kg m^2, body principal axes
-  double air_density = 1.225;               // kg/m^3
+  double mass = 80.0;                    // kg (airframe + avionics + fuel)
+  Vec3 inertia = Vec3(8.0, 22.0, 18.0);  // kg m^2, body principal axes
+  double air_density = 1.225;            // kg/m^3
 
   // Main rotor
-  double rotor_radius = 1.5575;             // m
-  double rotor_speed = 89.0;                // rad/s (850 rpm)
-  double lift_slope = 5.7;                  // per rad
-  double solidity = 0.053;                  // 2 blades, 0.13 m chord
-  double profile_drag = 0.010;              // blade section drag coefficient
-  double inflow_time_constant = 0.10;       // s, lag of induced velocity
-  double hub_height = 0.60;                 // m, hub above the centre of mass
-  double flap_stiffness = 200.0;            // N m/rad, effective hub spring
-  double flap_time_constant = 0.15;         // s, rotor + stabiliser bar
-  double cyclic_to_flap = 1.0;              // rad of disk tilt per rad of cyclic
-  double flap_blowback = 0.010;             // rad of disk tilt per m/s of airspeed
+  double rotor_radius = 1.5575;        // m
+  double rotor_speed = 89.0;           // rad/s (850 rpm)
+  double lift_slope = 5.7;             // per rad
+  double solidity = 0.053;             // 2 blades, 0.13 m chord
+  double profile_drag = 0.010;         // blade section drag coefficient
+  double inflow_time_constant = 0.10;  // s, lag of induced velocity
+  double hub_height = 0.60;            // m, hub above the centre of mass
+  double flap_stiffness = 200.0;       // N m/rad, effective hub spring
+  double flap_time_constant = 0.15;    // s, rotor + stabiliser bar
+  double cyclic_to_flap = 1.0;         // rad of disk tilt per rad of cyclic
+  double flap_blowback = 0.010;        // rad of disk tilt per m/s of airspeed
 
   // Tail rotor (pushes the tail to the right for positive thrust)
-  double tail_arm = 1.90;                   // m behind the centre of mass
-  double tail_thrust_per_rad = 355.0;       // N per rad of tail pitch
-  double tail_velocity_damping = 5.0;       // N per m/s of sideways flow at the tail
+  double tail_arm = 1.90;              // m behind the centre of mass
+  double tail_thrust_per_rad = 355.0;  // N per rad of tail pitch
+  double tail_velocity_damping = 5.0;  // N per m/s of sideways flow at the tail
 
   // Fuselage drag areas (body axes), m^2
   Vec3 drag_area = Vec3(0.30, 1.10, 1.30);
@@ -63,8 +63,8 @@ struct RotorcraftParams {
   // Actuators: limits, rates and servo lag
   Controls min_controls{-0.05, -0.16, -0.16, -0.40};
   Controls max_controls{0.30, 0.16, 0.16, 0.40};
-  double actuator_rate = 1.5;               // rad/s, every channel
-  double servo_time_constant = 0.04;        // s
+  double actuator_rate = 1.5;         // rad/s, every channel
+  double servo_time_constant = 0.04;  // s
 
   double disk_area() const { return kPi * rotor_radius * rotor_radius; }
   double tip_speed() const { return rotor_speed * rotor_radius; }
@@ -72,21 +72,21 @@ struct RotorcraftParams {
 
 /// Full state. Attitude is the body-to-world quaternion.
 struct RotorcraftState {
-  Vec3 position = Vec3::Zero();   // m, NED
-  Vec3 velocity = Vec3::Zero();   // m/s, NED
+  Vec3 position = Vec3::Zero();  // m, NED
+  Vec3 velocity = Vec3::Zero();  // m/s, NED
   Quat attitude = Quat::Identity();
-  Vec3 body_rates = Vec3::Zero(); // rad/s
-  double flap_lon = 0;            // rad, disk tilt forward relative to the shaft
-  double flap_lat = 0;            // rad, disk tilt right
-  double induced_velocity = 0;    // m/s, main-rotor inflow
-  Controls actuators;             // actual actuator positions
+  Vec3 body_rates = Vec3::Zero();  // rad/s
+  double flap_lon = 0;             // rad, disk tilt forward relative to the shaft
+  double flap_lat = 0;             // rad, disk tilt right
+  double induced_velocity = 0;     // m/s, main-rotor inflow
+  Controls actuators;              // actual actuator positions
 };
 
 /// Forces and moments of one evaluation, for inspection and tests.
 struct RotorcraftLoads {
-  double thrust = 0;          // N
-  double rotor_torque = 0;    // N m
-  double tail_thrust = 0;     // N
+  double thrust = 0;        // N
+  double rotor_torque = 0;  // N m
+  double tail_thrust = 0;   // N
   Vec3 force_body = Vec3::Zero();
   Vec3 moment_body = Vec3::Zero();
 };
@@ -142,7 +142,7 @@ struct TrimResult {
   bool converged = false;
   RotorcraftState state;  // with flapping, inflow and actuators at equilibrium
   Controls controls;
-  double residual = 0;    // largest |acceleration| component left, SI
+  double residual = 0;  // largest |acceleration| component left, SI
 };
 
 /// Finds controls and roll/pitch for steady flight at `velocity` (NED) with
