@@ -10,8 +10,10 @@ lcm-logger --lcm-url="udpm://239.255.76.67:7667?ttl=0" "$WORK/replayed.lcm" > /d
 logger=$!
 "$BIN/ofn_flight_monitor" --clock sim --timeout 60 --every 20 > "$WORK/monitor.txt" 2>&1 &
 monitor=$!
-sleep 0.5
-"$REPO/deploy/replay.sh" "$WORK/orig/flight.lcm" --speed 8 > "$WORK/replay.txt" 2>&1 ||
+# Give the logger and the monitor time to subscribe: what they miss of the
+# start of the replay would be missing from the comparison.
+sleep 1.5
+"$REPO/deploy/replay.sh" "$WORK/orig/flight.lcm" --speed 4 > "$WORK/replay.txt" 2>&1 ||
   { cat "$WORK/replay.txt"; fail "replay failed"; }
 wait $monitor || { cat "$WORK/monitor.txt"; fail "monitor did not see the arrival in the replay"; }
 kill -INT $logger; wait $logger || true
