@@ -165,36 +165,28 @@ std::vector<YamlReader> YamlReader::children(const std::string& key) {
   return out;
 }
 
-void YamlReader::finish() const {
-  std::vector<std::string> unknown;
-  for (const auto& kv : node_) {
-    const std::string key = kv.first.Scalar();
-    if (!used_.count(key)) unknown.push_back(key);
-  }
-  if (unknown.empty()) return;
+void YamlReader::fail_unknown(const std::string& key, const std::vector<std::string>& known) const {
   std::ostringstream s;
-  s << file_ << ": unknown field '" << field(unknown.front()) << "'";
-  if (!used_.empty()) {
+  s << file_ << ": unknown field '" << field(key) << "'";
+  if (!known.empty()) {
     s << " (known here:";
-    for (const auto& k : used_) s << " " << k;
+    for (const auto& k : known) s << " " << k;
     s << ")";
   }
   throw ConfigError(s.str());
 }
 
-}  // namespace ofn
-
-namespace ofn {
+void YamlReader::finish() const {
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.Scalar();
+    if (!used_.count(key)) fail_unknown(key, {used_.begin(), used_.end()});
+  }
+}
 
 void YamlReader::expect_only(const std::vector<std::string>& known) const {
   for (const auto& kv : node_) {
     const std::string key = kv.first.Scalar();
-    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
-    std::ostringstream s;
-    s << file_ << ": unknown field '" << field(key) << "' (known here:";
-    for (const auto& k : known) s << " " << k;
-    s << ")";
-    throw ConfigError(s.str());
+    if (std::find(known.begin(), known.end(), key) == known.end()) fail_unknown(key, known);
   }
 }
 

@@ -59,6 +59,8 @@ class YamlReader {
 
  private:
   YAML::Node scalar(const std::string& key);
+  [[noreturn]] void fail_unknown(const std::string& key,
+                                 const std::vector<std::string>& known) const;
 
   YAML::Node node_;
   std::string file_;
