@@ -31,3 +31,10 @@ find_package(Threads REQUIRED)
 # Java is only needed for the lcm-spy types jar; the flight stack builds without it.
 find_package(Java COMPONENTS Development QUIET)
 find_file(LCM_JAR lcm.jar PATHS /usr/share/java NO_DEFAULT_PATH)
+
+# OctoMap: the mapper's 3-D probabilistic occupancy (Debian ships its CMake package).
+find_package(octomap QUIET)
+ofn_require(octomap_FOUND "OctoMap" liboctomap-dev)
+add_library(ofn::octomap INTERFACE IMPORTED)
+set_target_properties(ofn::octomap PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${OCTOMAP_INCLUDE_DIRS}"
+                                              INTERFACE_LINK_LIBRARIES "${OCTOMAP_LIBRARIES}")

@@ -123,6 +123,13 @@ std::string validate(const scan_world_t& m) {
   if (!within_world(m.sensor_origin)) return "sensor origin not finite";
   for (const auto& p : m.points)
     if (!all_finite(p.begin(), p.end()) || p.size() != 3) return "point not finite";
+  if (auto e = check_count(m.num_free_rays, m.free_ray_ends.size(), MessageLimits::kMaxScanPoints,
+                           "free rays");
+      !e.empty())
+    return e;
+  for (const auto& p : m.free_ray_ends)
+    if (!all_finite(p.begin(), p.end()) || p.size() != 3) return "free ray end not finite";
+  if (m.num_rejected < 0) return "negative rejected count";
   return "";
 }
 

@@ -20,6 +20,22 @@ struct Limits {
   double sensor_range = 0;        // m
 };
 
+/// One obstacle of the course, SI and world NED. Boxes stand on the ground
+/// and may be yawed; cylinders and trees are vertical.
+struct ObstacleSpec {
+  enum class Kind { kBox, kCylinder, kTree };
+  Kind kind = Kind::kBox;
+  int id = 0;                        // unique within the scenario, from 1
+  double north = 0, east = 0;        // m, centre of the footprint
+  double length = 0, width = 0;      // m; box: along its x / y; cylinder: diameter, diameter;
+                                     // tree: canopy extent along north / east
+  double height = 0;                 // m above ground (tree: canopy top)
+  double yaw = 0;                    // rad from north, positive to the east (boxes only)
+  int seed = 0;                      // tree canopy shape
+  double appear_time = -1;           // s after the start; negative: present from the start
+  double disappear_time = -1;        // s after the start; negative: never removed
+};
+
 struct Waypoint {
   Vec3 position = Vec3::Zero();  // m, world NED
   double capture_radius = 0;     // m
@@ -44,6 +60,9 @@ struct Scenario {
   /// first crossing of start_gate and stops at the first of finish_gate.
   std::optional<double> start_gate;
   std::optional<double> finish_gate;
+
+  std::vector<ObstacleSpec> obstacles;
+  double ground_altitude = 0;  // m; the flat ground is the plane z = -ground_altitude
 
   Vec3 wind = Vec3::Zero();  // m/s, world NED, velocity of the air mass
   double max_time = 600;     // s of simulated time before a run is abandoned
