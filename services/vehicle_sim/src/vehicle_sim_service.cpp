@@ -1,10 +1,63 @@
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
 
+#include <cmath>
+#include <string>
+#include <vector>
+
 #include "ofn/common/channels.hpp"
+#include "ofn/common/obstacle_messages.hpp"
+#include "ofn/lidar_scan_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/sim_clock_t.hpp"
 
 namespace ofn::vehicle {
+namespace {
+
+static_assert(kLidarOk == lidar_scan_t::OK && kLidarNoReturn == lidar_scan_t::NO_RETURN &&
+                  kLidarSaturated == lidar_scan_t::SATURATED &&
+                  kLidarMaxRange == lidar_scan_t::MAX_RANGE,
+              "beam status codes must match lidar_scan_t");
+
+LidarConfig load_lidar_config(YamlReader& r) {
+  LidarConfig c;
+  c.enabled = r.boolean("enabled", c.enabled);
+  c.scan_rate = r.number_in("scan_rate_hz", c.scan_rate, 0.1, 100.0);
+  c.layers = r.integer("layers", c.layers);
+  if (c.layers < 1 || c.layers > 16) r.fail("layers", "expected 1 to 16 layers");
+  c.layer_spacing = deg2rad(r.number_in("layer_spacing_deg", rad2deg(c.layer_spacing), 0.0, 10.0));
+  c.elevation_min =
+      deg2rad(r.number_in("elevation_min_deg", rad2deg(c.elevation_min), -90.0, 90.0));
+  c.elevation_max =
+      deg2rad(r.number_in("elevation_max_deg", rad2deg(c.elevation_max), -90.0, 90.0));
+  if (c.elevation_max < c.elevation_min)
+    r.fail("elevation_max_deg", "must not be below elevation_min_deg");
+  c.angular_resolution =
+      deg2rad(r.number_in("angular_resolution_deg", rad2deg(c.angular_resolution), 0.01, 10.0));
+  c.max_range = r.number_in("max_range", c.max_range, 0.0, 10000.0);
+  c.min_range = r.number_in("min_range", c.min_range, 0.0, 100.0);
+  if (c.max_range > 0 && c.min_range >= c.max_range) r.fail("min_range", "must be below max_range");
+  c.range_noise_sigma = r.number_in("range_noise_sigma", c.range_noise_sigma, 0.0, 10.0);
+  c.dropout_probability = r.number_in("dropout_probability", c.dropout_probability, 0.0, 1.0);
+  c.outlier_probability = r.number_in("outlier_probability", c.outlier_probability, 0.0, 1.0);
+  c.saturation_range = r.number_in("saturation_range", c.saturation_range, 0.0, 100.0);
+  c.saturation_probability =
+      r.number_in("saturation_probability", c.saturation_probability, 0.0, 1.0);
+  const int seed = r.integer("seed", static_cast<int>(c.seed));
+  if (seed < 0) r.fail("seed", "expected a whole number >= 0");
+  c.seed = static_cast<uint32_t>(seed);
+  const auto offset = r.numbers("mount_offset", {0.0, 0.0, 0.0});
+  c.mount_offset = Vec3(offset[0], offset[1], offset[2]);
+  const auto rpy = r.numbers("mount_rpy_deg", {0.0, 0.0, 0.0});
+  c.mount_rpy = Vec3(deg2rad(rpy[0]), deg2rad(rpy[1]), deg2rad(rpy[2]));
+  r.finish();
+  const double steps = std::round((c.elevation_max - c.elevation_min) / c.angular_resolution) + 1;
+  if (steps * c.layers > MessageLimits::kMaxBeams)
+    r.fail("angular_resolution_deg",
+           "too fine: a scan would exceed " + std::to_string(MessageLimits::kMaxBeams) + " beams");
+  return c;
+}
+
+}  // namespace
 
 VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
   VehicleSimConfig c;
@@ -27,6 +80,8 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
       airframe.number_in("servo_time_constant", p.servo_time_constant, 0.001, 1.0);
   p.actuator_rate = airframe.number_in("actuator_rate", p.actuator_rate, 0.01, 100.0);
   airframe.finish();
+  YamlReader lidar = r.child("lidar");
+  c.lidar = load_lidar_config(lidar);
   r.finish();
   if (c.nav_rate > c.physics_rate) r.fail("nav_rate_hz", "must not exceed physics_rate_hz");
   return c;
@@ -37,7 +92,9 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
     : node_("vehicle_sim", lcm, clock),
       config_(std::move(config)),
       real_time_factor_(real_time_factor),
-      model_(config_.params) {
+      model_(config_.params),
+      world_({}, scenario.ground_altitude),
+      lidar_(config_.lidar, scenario.limits.sensor_range) {
   model_.set_wind(scenario.wind);
   const TrimResult t = trim(model_, scenario.start_velocity, scenario.start_heading, scenario.wind);
   if (!t.converged)
@@ -62,6 +119,15 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
   node_.subscribe<control_status_t>(
       channels::kControlStatus, [this](const control_status_t& m) { on_control_status(m); },
       SubscribeOptions{1.0, 1.0});
+  // The obstacle injector sends the obstacles present now; until its first
+  // message the scanner sees the bare ground.
+  node_.subscribe<virtual_obstacles_t>(
+      channels::kVirtualObstacles,
+      [this](const virtual_obstacles_t& m) { on_virtual_obstacles(m); },
+      SubscribeOptions{5.0, 5.0});
+  if (config_.lidar.enabled)
+    node_.log().info("lidar: {} beams per scan at {:.1f} Hz, max range {:.1f} m",
+                     lidar_.beams_per_scan(), config_.lidar.scan_rate, lidar_.max_range());
   node_.add_timer(
       1.0 / config_.physics_rate, [this] { step_physics(); }, "physics");
   node_.add_timer(
@@ -80,6 +146,40 @@ void VehicleSimService::on_control_status(const control_status_t& m) {
     released_ = true;
     node_.log().info("controller engaged at t={:.2f} s: vehicle released", to_seconds(node_.now()));
   }
+}
+
+void VehicleSimService::on_virtual_obstacles(const virtual_obstacles_t& m) {
+  std::vector<ObstacleSpec> specs;
+  specs.reserve(m.obstacles.size());
+  for (const auto& o : m.obstacles) specs.push_back(from_message(o));
+  world_.set_ground_altitude(m.ground_altitude);
+  world_.set_obstacles(specs);
+  if (m.revision != obstacle_revision_) {
+    obstacle_revision_ = m.revision;
+    node_.log().info("virtual obstacles revision {}: {} obstacles", m.revision, specs.size());
+  }
+}
+
+void VehicleSimService::publish_scan(const LidarScan& scan) {
+  lidar_scan_t msg;
+  msg.utime = scan.utime;
+  msg.scan_index = scan.scan_index;
+  msg.max_range = scan.max_range;
+  msg.num_beams = static_cast<int32_t>(scan.beams.size());
+  msg.beam_dt_us.reserve(scan.beams.size());
+  msg.elevation.reserve(scan.beams.size());
+  msg.layer_angle.reserve(scan.beams.size());
+  msg.range.reserve(scan.beams.size());
+  msg.status.reserve(scan.beams.size());
+  for (const LidarBeam& b : scan.beams) {
+    msg.beam_dt_us.push_back(b.dt_us);
+    msg.elevation.push_back(b.elevation);
+    msg.layer_angle.push_back(b.layer_angle);
+    msg.range.push_back(b.range);
+    msg.status.push_back(b.status);
+  }
+  node_.publish(channels::kLidarRaw, msg);
+  ++scans_published_;
 }
 
 void VehicleSimService::step_physics() {
@@ -105,6 +205,11 @@ void VehicleSimService::step_physics() {
     }
     state_time_ += dt_us;
     ++steps_;
+    if (config_.lidar.enabled) {
+      const RotorcraftState& s = model_.state();
+      lidar_.advance(state_time_, s.position, s.attitude, world_);
+      while (auto scan = lidar_.take_completed_scan()) publish_scan(*scan);
+    }
   }
   const bool commanded = last_command_time_ != INT64_MIN &&
                          now - last_command_time_ <= to_utime(config_.command_timeout);

@@ -1,13 +1,17 @@
 #pragma once
-// Binds the rotorcraft model to the bus: ACTUATOR_CMD in; NAV_STATE and
-// SIM_CLOCK out. Physics runs on a fixed-step timer of the node's clock.
+// Binds the rotorcraft model and the LIDAR head to the bus: ACTUATOR_CMD,
+// CONTROL_STATUS and VIRTUAL_OBSTACLES in; NAV_STATE, SIM_CLOCK and LIDAR_RAW
+// out. Physics and the scanner run on a fixed-step timer of the node's clock.
 
 #include <string>
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/vehicle_sim/lidar_head.hpp"
 #include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/virtual_obstacles_t.hpp"
+#include "ofn/world/world.hpp"
 
 namespace ofn::vehicle {
 
@@ -22,6 +26,7 @@ struct VehicleSimConfig {
   /// Release the hold after this long anyway (s of clock time).
   double engage_timeout = 10.0;
   RotorcraftParams params;
+  LidarConfig lidar;
 };
 
 /// Reads a vehicle_sim config; unknown fields are errors.
@@ -35,10 +40,15 @@ class VehicleSimService {
   Node& node() { return node_; }
   const RotorcraftModel& model() const { return model_; }
   bool released() const { return released_; }
+  const world::World& world() const { return world_; }
+  const LidarHead& lidar() const { return lidar_; }
+  int64_t scans_published() const { return scans_published_; }
 
  private:
   void on_command(const actuator_cmd_t& msg);
   void on_control_status(const control_status_t& msg);
+  void on_virtual_obstacles(const virtual_obstacles_t& msg);
+  void publish_scan(const LidarScan& scan);
   void step_physics();
   void publish_nav();
 
@@ -53,6 +63,10 @@ class VehicleSimService {
   Utime hold_started_ = INT64_MIN;
   bool released_ = false;
   int64_t steps_ = 0;
+  world::World world_;
+  LidarHead lidar_;
+  int32_t obstacle_revision_ = -1;
+  int64_t scans_published_ = 0;
 };
 
 }  // namespace ofn::vehicle

@@ -21,7 +21,8 @@ struct CanopyBlob {
 /// One obstacle with its geometry expanded for fast queries.
 class Obstacle {
  public:
-  explicit Obstacle(const ObstacleSpec& spec);
+  /// ground_altitude: altitude of the ground the obstacle stands on.
+  explicit Obstacle(const ObstacleSpec& spec, double ground_altitude = 0.0);
 
   const ObstacleSpec& spec() const { return spec_; }
   /// Present at time t (s after the start), honouring appear/disappear times.
@@ -41,6 +42,8 @@ class Obstacle {
   /// The canopy spheres of a tree (empty for other kinds).
   const std::vector<CanopyBlob>& canopy() const { return canopy_; }
   double trunk_radius() const { return trunk_radius_; }
+  /// Altitude of the top of a tree's trunk (0 for other kinds).
+  double trunk_top_altitude() const { return trunk_top_altitude_; }
 
  private:
   ObstacleSpec spec_;
@@ -64,7 +67,8 @@ class World {
 
   /// Replaces the obstacle set (e.g. from VIRTUAL_OBSTACLES).
   void set_obstacles(const std::vector<ObstacleSpec>& specs);
-  void set_ground_altitude(double altitude) { ground_altitude_ = altitude; }
+  /// Moves the ground and the obstacles standing on it.
+  void set_ground_altitude(double altitude);
   double ground_altitude() const { return ground_altitude_; }
   const std::vector<Obstacle>& obstacles() const { return obstacles_; }
 
@@ -77,6 +81,7 @@ class World {
   double distance_to_obstacles(const Vec3& p, double t = -1.0) const;
 
  private:
+  std::vector<ObstacleSpec> specs_;
   std::vector<Obstacle> obstacles_;
   double ground_altitude_ = 0;
 };
