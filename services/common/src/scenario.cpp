@@ -1,13 +1,85 @@
 #include "ofn/common/scenario.hpp"
 
+#include <algorithm>
+#include <map>
+
 #include "ofn/common/config.hpp"
 
 namespace ofn {
+namespace {
+
+double positive(YamlReader& r, const std::string& key, double value) {
+  if (!(value > 0)) r.fail(key, "must be > 0");
+  return value;
+}
+
+/// One entry of the `obstacles` list; `index` is its 0-based position.
+ObstacleSpec read_obstacle(YamlReader& o, size_t index, double metres_per_unit) {
+  o.expect_only({"kind", "id", "center", "size", "radius", "height", "yaw_deg", "seed",
+                 "appear_time", "disappear_time"});
+  const double k = metres_per_unit;
+  ObstacleSpec spec;
+  const std::string kind = o.text("kind");
+  if (kind == "box") {
+    spec.kind = ObstacleSpec::Kind::kBox;
+  } else if (kind == "cylinder") {
+    spec.kind = ObstacleSpec::Kind::kCylinder;
+  } else if (kind == "tree") {
+    spec.kind = ObstacleSpec::Kind::kTree;
+  } else {
+    o.fail("kind", "expected box, cylinder or tree, got '" + kind + "'");
+  }
+  const bool is_box = spec.kind == ObstacleSpec::Kind::kBox;
+  const bool is_cylinder = spec.kind == ObstacleSpec::Kind::kCylinder;
+  const bool is_tree = spec.kind == ObstacleSpec::Kind::kTree;
+
+  spec.id = o.integer("id", static_cast<int>(index) + 1);
+  if (spec.id <= 0) o.fail("id", "must be > 0");
+
+  const auto center = o.numbers("center", 2);
+  spec.north = center[0] * k;
+  spec.east = center[1] * k;
+
+  // Each kind takes exactly its own shape fields, so that a field meant for
+  // another kind is an error rather than silently ignored.
+  if (is_cylinder) {
+    if (o.has("size")) o.fail("size", "a cylinder takes radius, not size");
+    if (!o.has("radius")) o.fail("radius", "required number is missing");
+    const double radius = positive(o, "radius", o.number("radius"));
+    spec.length = spec.width = 2.0 * radius * k;
+  } else {
+    if (o.has("radius"))
+      o.fail("radius", "only a cylinder takes a radius; a " + kind + " takes size");
+    const auto size = o.numbers("size", 2);
+    spec.length = positive(o, "size", size[0]) * k;
+    spec.width = positive(o, "size", size[1]) * k;
+  }
+  spec.height = positive(o, "height", o.number("height")) * k;
+
+  if (!is_box && o.has("yaw_deg")) o.fail("yaw_deg", "only a box has a yaw");
+  // Course yaw (from +x, positive to the right) is NED yaw (from north to east).
+  spec.yaw = deg2rad(o.number_in("yaw_deg", 0.0, -360.0, 360.0));
+
+  if (!is_tree && o.has("seed")) o.fail("seed", "only a tree has a seed");
+  spec.seed = o.integer("seed", spec.id);
+
+  if (o.has("appear_time")) spec.appear_time = o.number_in("appear_time", 0.0, 0.0, 1e6);
+  if (o.has("disappear_time")) {
+    spec.disappear_time = o.number_in("disappear_time", 0.0, 0.0, 1e6);
+    const double appears = std::max(spec.appear_time, 0.0);
+    if (spec.disappear_time <= appears)
+      o.fail("disappear_time", "must be later than appear_time (the start if absent)");
+  }
+  o.finish();
+  return spec;
+}
+
+}  // namespace
 
 Scenario load_scenario(const std::string& path) {
   YamlReader root = YamlReader::load_file(path);
   root.expect_only({"name", "description", "units", "start", "waypoints", "capture_radius",
-                    "cruise_speed", "limits", "gates", "environment", "max_time"});
+                    "cruise_speed", "limits", "gates", "environment", "obstacles", "max_time"});
   Scenario s;
   s.file = path;
   s.name = root.text("name");
@@ -71,7 +143,19 @@ Scenario load_scenario(const std::string& path) {
   const auto wind = env.numbers("wind", {0.0, 0.0, 0.0});
   // Wind is given in the course frame too (x, y, h-rate); NED flips the last.
   s.wind = course_to_ned(Vec3(wind[0], wind[1], wind[2]) * k);
+  s.ground_altitude = env.number_in("ground_altitude", 0.0, -1e5, 1e5) * k;
   env.finish();
+
+  auto obstacles = root.children("obstacles");
+  std::map<int, size_t> index_of_id;
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    ObstacleSpec spec = read_obstacle(obstacles[i], i, k);
+    const auto [it, inserted] = index_of_id.emplace(spec.id, i);
+    if (!inserted)
+      obstacles[i].fail("id", "duplicate id " + std::to_string(spec.id) + " (also obstacles[" +
+                                  std::to_string(it->second) + "])");
+    s.obstacles.push_back(spec);
+  }
 
   s.max_time = root.number_in("max_time", 600.0, 1.0, 1e6);
   root.finish();
