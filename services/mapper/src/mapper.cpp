@@ -1,1 +1,220 @@
-// placeholder: being written
+#include "ofn/mapper/mapper.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace ofn::mapping {
+namespace {
+
+/// Cells a beam must continue past a cell for it to have passed over it.
+constexpr double kSeenOverContinuation = 3.0;
+
+}  // namespace
+
+Mapper::Mapper(const MapperConfig& config)
+    : config_(config),
+      grid_(config.grid),
+      confirmed_(config.grid),
+      seen_over_(config.grid),
+      occupancy_(config.occupancy),
+      extractor_(config.cuboids),
+      database_(config.database) {}
+
+void Mapper::set_vehicle_position(const Vec3& ned) {
+  vehicle_ = ned;
+  grid_.recentre(ned.x(), ned.y());
+  seen_over_.recentre(ned.x(), ned.y());
+}
+
+void Mapper::add_scan(const ScanInput& scan) {
+  ++counters_.scans;
+  counters_.points += grid_.insert_hits(scan.points);
+  if (config_.use_occupancy)
+    occupancy_.insert_scan(scan.sensor_origin, scan.points, scan.free_ray_ends);
+  seen_points_.clear();
+  for (const auto& p : scan.points) trace_over_tops(scan.sensor_origin, p, seen_points_);
+  for (const auto& p : scan.free_ray_ends) trace_over_tops(scan.sensor_origin, p, seen_points_);
+  seen_over_.insert_hits(seen_points_);
+}
+
+void Mapper::trace_over_tops(const Vec3& origin, const Vec3& end,
+                             std::vector<Vec3>& seen_points) const {
+  // 2-D walk (Amanatides-Woo) through the cells under the beam. Only cells
+  // the beam leaves again count, and only where it stays above the cell's
+  // top by at most the band: then the space just above that top was seen.
+  const Heightfield& raw = grid_.raw();
+  if (raw.empty()) return;
+  const double ground = config_.grid.ground_altitude;
+  const double res = raw.resolution;
+  const double a0 = -origin.z() - ground, a1 = -end.z() - ground;
+  const double gn = (origin.x() - raw.origin_north) / res,
+               ge = (origin.y() - raw.origin_east) / res;
+  const double dn = (end.x() - origin.x()) / res, de = (end.y() - origin.y()) / res;
+  int row = static_cast<int>(std::floor(gn)), col = static_cast<int>(std::floor(ge));
+  const int step_r = dn > 0 ? 1 : -1, step_c = de > 0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double dt_r = dn != 0 ? std::abs(1.0 / dn) : inf;
+  const double dt_c = de != 0 ? std::abs(1.0 / de) : inf;
+  double t_r = dn > 0 ? (row + 1 - gn) * dt_r : dn < 0 ? (gn - row) * dt_r : inf;
+  double t_c = de > 0 ? (col + 1 - ge) * dt_c : de < 0 ? (ge - col) * dt_c : inf;
+  double t_enter = 0;
+  const double band = config_.top_seen_band;
+  // The beam must go on well past the cell: one that runs out of range just
+  // behind a wall's face plane (or skims the free front part of a face
+  // cell) proves nothing, one that continues several cells at that height
+  // without a return proves the wall is not there.
+  const double length_cells = std::hypot(dn, de);
+  const double min_continuation = kSeenOverContinuation;
+  while (true) {
+    const double t_exit = std::min(t_r, t_c);
+    if ((1.0 - t_exit) * length_cells < min_continuation) break;
+    if (t_enter > 0 && raw.inside(row, col)) {
+      const float top = raw.at(row, col);
+      if (top > 0.0f) {
+        const double lowest = std::min(a0 + t_enter * (a1 - a0), a0 + t_exit * (a1 - a0));
+        if (lowest > top && lowest <= top + band)
+          seen_points.emplace_back(raw.cell_centre_north(row), raw.cell_centre_east(col),
+                                   -(ground + top));
+      }
+    }
+    t_enter = t_exit;
+    if (t_r < t_c) {
+      row += step_r;
+      t_r += dt_r;
+    } else {
+      col += step_c;
+      t_c += dt_c;
+    }
+  }
+}
+
+bool Mapper::rectangle_top_seen(double min_n, double min_e, double max_n, double max_e,
+                                double top) const {
+  // The cells that hold the rectangle's top decide: seen if a beam passed
+  // over any of them at their present height.
+  const Heightfield& raw = grid_.raw();
+  const Heightfield& seen = seen_over_.raw();
+  const double eps = 1e-6 * raw.resolution;
+  const int r0 = std::max(0, raw.row_of(min_n + eps)),
+            r1 = std::min(raw.rows - 1, raw.row_of(max_n - eps));
+  const int c0 = std::max(0, raw.col_of(min_e + eps)),
+            c1 = std::min(raw.cols - 1, raw.col_of(max_e - eps));
+  const double tolerance = config_.occupancy.resolution + raw.resolution;
+  for (int r = r0; r <= r1; ++r)
+    for (int c = c0; c <= c1; ++c) {
+      const float cell_top = raw.at(r, c);
+      if (cell_top > 0.0f && cell_top >= top - tolerance && seen.at(r, c) >= cell_top - 1e-3f)
+        return true;
+    }
+  return false;
+}
+
+void Mapper::reconcile_with_occupancy() {
+  // A grid cell keeps its highest hit for ever in the paper's design. Here
+  // the occupancy map has the last word: where beams have since passed
+  // through the space a hit claimed, the cell comes down to what is still
+  // occupied (nothing, for a false return or a removed obstacle).
+  const Heightfield& raw = grid_.raw();
+  const double voxel = config_.occupancy.resolution;
+  const double half = 0.5 * raw.resolution;
+  for (int r = 0; r < raw.rows; ++r) {
+    for (int c = 0; c < raw.cols; ++c) {
+      const float top = raw.at(r, c);
+      if (top <= 0.0f) continue;
+      // Altitudes of the occupancy queries are above the ground, like the grid's.
+      const double occupied_above_ground =
+          occupancy_.column_top(raw.cell_centre_north(r), raw.cell_centre_east(c), half,
+                                config_.grid.ground_clearance, top + voxel);
+      if (occupied_above_ground < 0) {
+        grid_.lower_cell(r, c, 0.0f);
+        ++counters_.cells_lowered;
+      } else if (occupied_above_ground < top - voxel) {
+        grid_.lower_cell(r, c, static_cast<float>(occupied_above_ground));
+        ++counters_.cells_lowered;
+      }
+    }
+  }
+}
+
+Heightfield Mapper::confirmed_grid() {
+  // The planner's cuboids come only from cells whose column the occupancy
+  // map holds with confidence: one stray return shows in the grid at once
+  // (conservative for the optimiser) but must be seen again before it can
+  // become an obstacle in the database.
+  confirmed_ = grid_;
+  const Heightfield& raw = grid_.raw();
+  const double voxel = config_.occupancy.resolution;
+  const double half = 0.5 * raw.resolution;
+  for (int r = 0; r < raw.rows; ++r) {
+    for (int c = 0; c < raw.cols; ++c) {
+      const float top = raw.at(r, c);
+      if (top <= 0.0f) continue;
+      const double confirmed_top = occupancy_.column_top(
+          raw.cell_centre_north(r), raw.cell_centre_east(c), half, config_.grid.ground_clearance,
+          top + voxel, config_.confirm_probability);
+      if (confirmed_top < 0)
+        confirmed_.lower_cell(r, c, 0.0f);
+      else
+        confirmed_.lower_cell(r, c, static_cast<float>(std::min<double>(top, confirmed_top)));
+    }
+  }
+  return confirmed_.filtered();
+}
+
+void Mapper::update_cuboids(Utime now) {
+  ++counters_.cycles;
+  Heightfield source;
+  if (config_.use_occupancy) {
+    reconcile_with_occupancy();
+    occupancy_.forget_far(vehicle_.x(), vehicle_.y());
+    source = confirmed_grid();
+  } else {
+    source = grid_.filtered();
+  }
+  const double ground = config_.grid.ground_altitude;
+  const CuboidExtractor::TopSeen top_seen = [this, ground](double min_n, double min_e, double max_n,
+                                                           double max_e, double top_altitude) {
+    return rectangle_top_seen(min_n, min_e, max_n, max_e, top_altitude - ground);
+  };
+  extracted_ = extractor_.extract(source, top_seen);
+
+  // Only obstacles whose footprint lies wholly on the grid could have been
+  // found again; the rest were left behind and are kept as they are.
+  const double n0 = source.origin_north, e0 = source.origin_east;
+  const double n1 = n0 + source.rows * source.resolution;
+  const double e1 = e0 + source.cols * source.resolution;
+  // A blob cut by the grid's edge is only the part still on the grid: it
+  // extends what the database knows of that obstacle instead of replacing it.
+  const double edge = source.resolution * 1.5;
+  for (auto& c : extracted_) {
+    const bool cut = c.min.x() < n0 + edge || c.max.x() > n1 - edge || c.min.y() < e0 + edge ||
+                     c.max.y() > e1 - edge;
+    if (!cut) continue;
+    for (const auto& entry : database_.entries()) {
+      if (footprint_overlap(c, entry.cuboid) < config_.database.match_overlap) continue;
+      // The higher top wins, with what is known about it.
+      if (entry.cuboid.min.z() < c.min.z()) c.top_observed = entry.cuboid.top_observed;
+      c.min = c.min.cwiseMin(entry.cuboid.min);
+      c.max = c.max.cwiseMax(entry.cuboid.max);
+    }
+  }
+  // Extended pieces of one obstacle may now coincide: keep one of each.
+  auto contains = [](const Cuboid& outer, const Cuboid& inner) {
+    return (outer.min.array() <= inner.min.array()).all() &&
+           (outer.max.array() >= inner.max.array()).all();
+  };
+  for (size_t i = 0; i < extracted_.size(); ++i)
+    for (size_t j = 0; j < extracted_.size(); ++j)
+      if (i != j && contains(extracted_[j], extracted_[i]) &&
+          (!contains(extracted_[i], extracted_[j]) || j < i)) {
+        extracted_.erase(extracted_.begin() + static_cast<std::ptrdiff_t>(i));
+        --i;
+        break;
+      }
+  database_.update(extracted_, now, [=](const Cuboid& c) {
+    return c.min.x() >= n0 && c.max.x() <= n1 && c.min.y() >= e0 && c.max.y() <= e1;
+  });
+}
+
+}  // namespace ofn::mapping

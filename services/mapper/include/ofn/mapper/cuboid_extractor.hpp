@@ -28,6 +28,7 @@ struct CuboidExtractorConfig {
   double min_split_size = 4.0;    // m; rectangles are not split below this edge length
   double ground_altitude = 0;     // m
   double ceiling = 150.0;         // m above ground; top of cuboids whose top was not seen
+  int max_split_depth = 8;        // bounds the halving of one blob (at most 2^depth rectangles)
 };
 
 class CuboidExtractor {
@@ -36,10 +37,13 @@ class CuboidExtractor {
 
   /// Optional check whether the space just above a rectangle's top was ever
   /// seen (arguments: the rectangle min/max corner north/east and its top
-  /// altitude). Without it every top counts as observed.
+  /// altitude, i.e. ground_altitude + the cell top, as Cuboid::top_altitude()).
+  /// Without it every top counts as observed.
   using TopSeen = std::function<bool(double min_north, double min_east, double max_north,
                                      double max_east, double top_altitude)>;
 
+  /// Cuboids ordered by min north, then min east. Throws std::invalid_argument
+  /// if the grid's cell count or resolution is inconsistent.
   std::vector<Cuboid> extract(const Heightfield& filtered, const TopSeen& top_seen = {}) const;
 
  private:

@@ -25,11 +25,15 @@ struct ObstacleDatabaseConfig {
 struct ObstacleEntry {
   int id = 0;
   Cuboid cuboid;
-  double confidence = 0;    // 0..1
+  double confidence = 0;  // 0..1
   Utime first_seen = 0;
   Utime last_seen = 0;
   int misses = 0;
 };
+
+/// Intersection area of the two north/east footprints divided by the smaller
+/// footprint's area; 0 if either footprint has no area.
+double footprint_overlap(const Cuboid& a, const Cuboid& b);
 
 class ObstacleDatabase {
  public:
@@ -37,13 +41,17 @@ class ObstacleDatabase {
 
   /// One cycle. `in_view` tells whether a database entry's footprint lies
   /// where the current grid/sensor could have seen it: only such entries can
-  /// be missed (and retired); the others are kept as they are.
+  /// be missed (and retired); the others are kept as they are. An empty
+  /// `in_view` counts every entry as in view.
   void update(const std::vector<Cuboid>& extracted, Utime now,
               const std::function<bool(const Cuboid&)>& in_view);
 
   const std::vector<ObstacleEntry>& entries() const { return entries_; }
   int inserted() const { return inserted_; }
   int retired() const { return retired_; }
+  /// Entries absorbed into a lower-id entry that one extracted cuboid matched
+  /// together with them.
+  int merged() const { return merged_; }
   void clear() { entries_.clear(); }
 
  private:
@@ -52,6 +60,7 @@ class ObstacleDatabase {
   int next_id_ = 1;
   int inserted_ = 0;
   int retired_ = 0;
+  int merged_ = 0;
 };
 
 }  // namespace ofn::mapping

@@ -17,8 +17,8 @@ class OcTree;
 namespace ofn::mapping {
 
 struct OccupancyMapConfig {
-  double resolution = 1.0;       // m, voxel edge
-  double max_range = 61.0;       // m, beams are integrated up to this range
+  double resolution = 1.0;  // m, voxel edge
+  double max_range = 61.0;  // m, beams are integrated up to this range
   double prob_hit = 0.7;
   double prob_miss = 0.4;
   double clamp_min = 0.12;
@@ -36,17 +36,26 @@ class OccupancyMap {
   OccupancyMap& operator=(const OccupancyMap&) = delete;
 
   /// Integrates one scan: hits end occupied, every beam (including the free
-  /// rays that reached max range without a return) carves free space.
+  /// rays that reached max range without a return) carves free space. Hits
+  /// beyond max_range count as free rays cut at max_range. Within one scan
+  /// each voxel is updated once, and a voxel holding a hit is not also
+  /// carved. The tree's coordinates are world NED.
   void insert_scan(const Vec3& sensor_origin, const std::vector<Vec3>& hits,
                    const std::vector<Vec3>& free_ray_ends);
 
   /// Highest occupied voxel top (m above ground) in the vertical column
   /// around (north, east) of the given horizontal half size, searched
-  /// between two altitudes; negative when none.
-  double column_top(double north, double east, double half_size, double alt_lo,
-                    double alt_hi) const;
-  /// True when some voxel of the column within [alt_lo, alt_hi] is known
-  /// free (has been crossed by a beam), i.e. the space above a top was seen.
+  /// between two altitudes (m above ground); negative when none. A voxel
+  /// counts when its occupancy probability reaches min_probability (never
+  /// less than the map's occupied threshold, which is the default). Voxels
+  /// count when they overlap the column's interior: a bound lying exactly
+  /// on a voxel face does not pull in the voxel beyond it. The returned top
+  /// is the voxel's upper face, so it may exceed alt_hi by under a voxel.
+  double column_top(double north, double east, double half_size, double alt_lo, double alt_hi,
+                    double min_probability = 0.0) const;
+  /// True when some voxel of the column within [alt_lo, alt_hi] (m above
+  /// ground) is known free (has been crossed by a beam), i.e. the space
+  /// above a top was seen.
   bool column_seen_free(double north, double east, double half_size, double alt_lo,
                         double alt_hi) const;
 

@@ -1,0 +1,95 @@
+#pragma once
+// The mapper's core: one scan at a time into the vehicle-attached grid and
+// the 3-D occupancy map; once a second, the grid is reconciled with the
+// occupancy evidence (false returns fade, removed obstacles go), cuboids are
+// extracted from the confirmed part of the grid and the obstacle database is
+// updated. No LCM in here; MapperService binds it to the bus.
+
+#include <cstdint>
+#include <vector>
+
+#include "ofn/common/clock.hpp"
+#include "ofn/common/frames.hpp"
+#include "ofn/mapper/cuboid_extractor.hpp"
+#include "ofn/mapper/obstacle_database.hpp"
+#include "ofn/mapper/obstacle_grid.hpp"
+#include "ofn/mapper/occupancy_map.hpp"
+
+namespace ofn::mapping {
+
+struct MapperConfig {
+  ObstacleGridConfig grid;
+  OccupancyMapConfig occupancy;
+  CuboidExtractorConfig cuboids;
+  ObstacleDatabaseConfig database;
+  /// Use the 3-D occupancy map to retire and confirm grid cells. Off: the
+  /// paper's grid alone (every hit stays forever).
+  bool use_occupancy = true;
+  /// Probability a voxel must reach before its column may form a cuboid:
+  /// higher than the occupancy threshold so that one stray return, which
+  /// the grid shows at once, needs a second hit before the planner sees it.
+  double confirm_probability = 0.8;
+  /// A cell's top counts as seen when a beam crossed the whole cell at most
+  /// this far above it (m). Beams that end inside a cell do not count: a
+  /// beam that ran out of range just in front of a wall's face says nothing
+  /// about its top.
+  double top_seen_band = 4.0;
+};
+
+struct ScanInput {
+  Utime utime = 0;
+  Vec3 sensor_origin = Vec3::Zero();  // world NED
+  std::vector<Vec3> points;           // hits, world NED
+  std::vector<Vec3> free_ray_ends;    // ends of beams without a return, world NED
+};
+
+struct MapperCounters {
+  int64_t scans = 0;
+  int64_t points = 0;         // hits landed on the grid
+  int64_t cells_lowered = 0;  // grid cells the occupancy map lowered or cleared
+  int64_t cycles = 0;         // cuboid cycles
+};
+
+class Mapper {
+ public:
+  explicit Mapper(const MapperConfig& config);
+
+  /// Moves the grid with the vehicle.
+  void set_vehicle_position(const Vec3& ned);
+  void add_scan(const ScanInput& scan);
+  /// One cuboid cycle (1 Hz): reconcile, extract, update the database.
+  void update_cuboids(Utime now);
+
+  const MapperConfig& config() const { return config_; }
+  /// The smoothed, inflated grid (OBSTACLE_GRID).
+  const Heightfield& grid() { return grid_.filtered(); }
+  const Heightfield& raw_grid() const { return grid_.raw(); }
+  const std::vector<ObstacleEntry>& obstacles() const { return database_.entries(); }
+  const std::vector<Cuboid>& last_extraction() const { return extracted_; }
+  const OccupancyMap& occupancy() const { return occupancy_; }
+  const MapperCounters& counters() const { return counters_; }
+  const ObstacleDatabase& database() const { return database_; }
+
+ private:
+  void reconcile_with_occupancy();
+  Heightfield confirmed_grid();
+  /// Marks the cells whose top the beam from `origin` to `end` passed over.
+  void trace_over_tops(const Vec3& origin, const Vec3& end, std::vector<Vec3>& seen_points) const;
+  bool rectangle_top_seen(double min_n, double min_e, double max_n, double max_e, double top) const;
+
+  MapperConfig config_;
+  ObstacleGrid grid_;
+  ObstacleGrid confirmed_;  // scratch: the grid's confirmed cells, inflated and smoothed
+  // Per cell, the highest top a beam has been seen to pass over (same
+  // geometry as grid_, moved with it).
+  ObstacleGrid seen_over_;
+  std::vector<Vec3> seen_points_;  // scratch
+  OccupancyMap occupancy_;
+  CuboidExtractor extractor_;
+  ObstacleDatabase database_;
+  Vec3 vehicle_ = Vec3::Zero();
+  std::vector<Cuboid> extracted_;
+  MapperCounters counters_;
+};
+
+}  // namespace ofn::mapping
