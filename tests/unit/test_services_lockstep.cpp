@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,13 +42,15 @@ struct FlightResult {
   int64_t messages = 0;
   int64_t controller_rejected = 0;
   int64_t sim_rejected = 0;
-  std::vector<int8_t> modes;  // distinct controller modes in order
+  std::vector<int8_t> modes;                              // distinct controller modes in order
+  std::vector<std::pair<double, double>> yaw_references;  // t, rad (CONTROL_STATUS)
 };
 
-FlightResult fly_open_course(const Scenario& scenario) {
+FlightResult fly_open_course(const Scenario& scenario, bool scanner = true) {
   sim::Lockstep lockstep;
-  vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), scenario,
-                                     default_sim_config());
+  auto sim_config = default_sim_config();
+  sim_config.lidar.enabled = scanner;
+  vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), scenario, sim_config);
   uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), kOpenScenario);
   control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
                                         default_controller_config());
@@ -55,6 +58,10 @@ FlightResult fly_open_course(const Scenario& scenario) {
   lockstep.add(uplink.node());
   lockstep.add(controller.node());
   FlightResult r;
+  Node recorder("recorder", lockstep.lcm(), lockstep.clock());
+  recorder.subscribe<control_status_t>(channels::kControlStatus, [&](const control_status_t& m) {
+    r.yaw_references.emplace_back(to_seconds(m.utime), m.yaw_reference);
+  });
   r.arrived = lockstep.run(to_utime(150.0), [&] {
     if (r.modes.empty() || r.modes.back() != controller.mode())
       r.modes.push_back(controller.mode());
@@ -92,6 +99,29 @@ TEST_F(LockstepServices, OpenCourseFlightArrivesAtTheLastWaypoint) {
   // Nobody rejected anything on a clean run.
   EXPECT_EQ(r.controller_rejected, 0);
   EXPECT_EQ(r.sim_rejected, 0);
+}
+
+/// Peak-to-peak yaw reference over a time window (rad).
+double yaw_span(const FlightResult& r, double from, double to) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& [t, yaw] : r.yaw_references)
+    if (t >= from && t <= to) {
+      lo = std::min(lo, yaw);
+      hi = std::max(hi, yaw);
+    }
+  return hi - lo;
+}
+
+TEST_F(LockstepServices, YawSweepsTheScannerOnlyWhileScansArrive) {
+  const Scenario scenario = load_scenario(kOpenScenario);
+  const FlightResult scanning = fly_open_course(scenario, true);
+  ASSERT_TRUE(scanning.arrived);
+  // 0.2 Hz, 40 deg peak to peak, faded in over the first period.
+  EXPECT_NEAR(rad2deg(yaw_span(scanning, 10.0, 15.0)), 40.0, 1.0);
+  EXPECT_LT(rad2deg(yaw_span(scanning, 0.0, 1.0)), 10.0);
+  const FlightResult blind = fly_open_course(scenario, false);
+  ASSERT_TRUE(blind.arrived);
+  EXPECT_LT(rad2deg(yaw_span(blind, 10.0, 15.0)), 1.0);
 }
 
 TEST_F(LockstepServices, SameScenarioGivesTheSameFlightBitForBit) {

@@ -64,6 +64,8 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.sweep.frequency = sweep.number_in("frequency_hz", c.sweep.frequency, 0.01, 5.0);
   c.sweep.total_angle =
       deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
+  c.sweep.scanner_timeout =
+      sweep.number_in("scanner_timeout", c.sweep.scanner_timeout, 0.05, 60.0);
   sweep.finish();
   YamlReader nominal = r.child("nominal_airframe");
   c.nominal.mass = nominal.number_in("mass", c.nominal.mass, 1.0, 1e4);
@@ -104,6 +106,10 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
   node_.subscribe<ref_traj_t>(
       channels::kRefTraj, [this](const ref_traj_t& m) { on_ref_traj(m); },
       SubscribeOptions{config_.ref_traj_timeout, 0.5});
+  if (config_.sweep.enabled)
+    node_.subscribe<lidar_scan_t>(
+        channels::kLidarRaw, [this](const lidar_scan_t&) { on_lidar_scan(); },
+        SubscribeOptions{config_.sweep.scanner_timeout, 0.5});
   node_.add_timer(
       1.0 / config_.rate, [this] { control_step(); }, "control");
   node_.add_timer(
@@ -119,6 +125,10 @@ void ControllerService::on_mission(const mission_t& m) {
                    m.num_waypoints, m.cruise_speed);
 }
 
+void ControllerService::on_lidar_scan() {
+  last_scan_ = node_.now();
+}
+
 double ControllerService::yaw_reference(const Vec3& leg_direction, double* yaw_rate) {
   // Face along the path; hold the last heading while hovering.
   if (std::hypot(leg_direction.x(), leg_direction.y()) > 0.2) {
@@ -127,12 +137,27 @@ double ControllerService::yaw_reference(const Vec3& leg_direction, double* yaw_r
   }
   double yaw = path_yaw_;
   *yaw_rate = 0;
-  if (config_.sweep.enabled && mode_ != control_status_t::HOLD) {
-    // Sweep the vertical scanner across the path (paper section 3.1).
+  const Utime now = node_.now();
+  const bool scanner_on = last_scan_ != INT64_MIN &&
+                          now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
+  if (!(config_.sweep.enabled && scanner_on && mode_ != control_status_t::HOLD)) {
+    if (sweep_since_ != INT64_MIN) node_.log().info("yaw sweep stopped");
+    sweep_since_ = INT64_MIN;
+  } else {
+    if (sweep_since_ == INT64_MIN) {
+      sweep_since_ = now;
+      node_.log().info("scanner active: yaw sweep started");
+    }
+    // yaw = a(t) * sin(w t) with the amplitude ramping linearly over one
+    // period from zero, so the commanded yaw and its rate start at zero.
     const double w = 2.0 * kPi * config_.sweep.frequency;
-    const double t = to_seconds(node_.now());
-    yaw += 0.5 * config_.sweep.total_angle * std::sin(w * t);
-    *yaw_rate = 0.5 * config_.sweep.total_angle * w * std::cos(w * t);
+    const double t = to_seconds(now - sweep_since_);
+    const double ramp = 1.0 / config_.sweep.frequency;
+    const double half = 0.5 * config_.sweep.total_angle;
+    const double a = half * std::min(1.0, t / ramp);
+    const double a_rate = t < ramp ? half / ramp : 0.0;
+    yaw += a * std::sin(w * t);
+    *yaw_rate = a_rate * std::sin(w * t) + a * w * std::cos(w * t);
   }
   return wrap_angle(yaw);
 }

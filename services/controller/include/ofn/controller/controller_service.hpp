@@ -10,16 +10,21 @@
 #include "ofn/common/node.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
+#include "ofn/lidar_scan_t.hpp"
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/ref_traj_t.hpp"
 
 namespace ofn::control {
 
+/// Oscillatory yaw that sweeps the vertical scanner across the path (paper
+/// section 3.1). It runs only while LIDAR scans arrive, and fades in over one
+/// period so that the yaw rate never steps.
 struct YawSweep {
-  bool enabled = false;
+  bool enabled = true;
   double frequency = 0.2;            // Hz
   double total_angle = deg2rad(40);  // rad, peak to peak
+  double scanner_timeout = 1.0;      // s without LIDAR_RAW after which the scanner counts as off
 };
 
 struct ControllerConfig {
@@ -44,11 +49,13 @@ class ControllerService {
   ControllerService(lcm::LCM& lcm, const Clock& clock, ControllerConfig config);
   Node& node() { return node_; }
   int8_t mode() const { return mode_; }
+  bool sweeping() const { return sweep_since_ != INT64_MIN; }
 
  private:
   void on_nav(const nav_state_t& m) { nav_ = m; }
   void on_mission(const mission_t& m);
   void on_ref_traj(const ref_traj_t& m) { ref_traj_ = m; }
+  void on_lidar_scan();
   void control_step();
   void publish_status();
   double yaw_reference(const Vec3& leg_direction, double* yaw_rate);
@@ -69,6 +76,8 @@ class ControllerService {
   Reference last_ref_;
   ControlOutput last_out_;
   Utime last_step_ = INT64_MIN;
+  Utime last_scan_ = INT64_MIN;
+  Utime sweep_since_ = INT64_MIN;  // start of the current sweep; INT64_MIN while off
 };
 
 }  // namespace ofn::control
