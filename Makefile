@@ -4,7 +4,7 @@
 
 BUILD    ?= build
 JOBS     ?= $(shell nproc)
-SCENARIO ?= sim/scenarios/open.yaml
+SCENARIO ?= sim/scenarios/bench3.yaml
 RTF      ?= 1.0
 PYTHON   := /usr/bin/python3
 

@@ -6,7 +6,7 @@
 #   deploy/fly.sh [--scenario FILE] [--rtf X] [--out DIR] [--timeout S] [--host-network]
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-scenario="$repo/sim/scenarios/open.yaml"
+scenario="$repo/sim/scenarios/bench3.yaml"
 rtf=1.0
 timeout=300
 out=""

@@ -144,7 +144,7 @@ def panel_top_view(ax, k, nav, ctl, wps, summary, gpath, ref, scan, cuboids):
     ax.autoscale_view()
 
 
-def panel_altitude(ax, k, nav, ctl, wps, summary, cuboids):
+def panel_altitude(ax, k, nav, ctl, wps, summary, cuboids, scan):
     for ob in summary.get("obstacles") or []:
         if ob.get("kind") in ("cylinder", "tree"):
             r = 0.5 * float(ob["size"][0])
@@ -160,8 +160,13 @@ def panel_altitude(ax, k, nav, ctl, wps, summary, cuboids):
         for i in range(nrows(cuboids)):
             n0, n1 = cuboids["min_n"][i] * k, cuboids["max_n"][i] * k
             h0, h1 = -cuboids["max_d"][i] * k, -cuboids["min_d"][i] * k
+            # A cuboid whose top the sensor never saw reaches the mapper's ceiling.
+            seen = "top_observed" not in cuboids or cuboids["top_observed"][i] > 0
             ax.add_patch(Rectangle((n0, h0), n1 - n0, h1 - h0, fill=False,
-                                   ls="--", ec="purple", lw=0.8))
+                                   ls="--" if seen else ":", ec="purple", lw=0.8))
+    if scan is not None and nrows(scan):
+        ax.plot(col(scan, "north") * k, -col(scan, "down") * k, ".", ms=1, color="0.6",
+                label="LIDAR hits")
     ax.plot(col(ctl, "ref_n") * k, -col(ctl, "ref_d") * k, "--", color="tab:red",
             lw=1, label="reference")
     ax.plot(col(nav, "north") * k, -col(nav, "down") * k, "-", color="tab:blue",
@@ -171,7 +176,13 @@ def panel_altitude(ax, k, nav, ctl, wps, summary, cuboids):
     if not nrows(nav):
         no_data(ax)
     ax.autoscale_view()
-    ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))  # always show the ground
+    # Unseen-top cuboids reach the mapper's ceiling; keep the view on the
+    # flight and the real obstacles instead.
+    tops = [float(ob.get("height", 0)) * k for ob in summary.get("obstacles") or []]
+    if nrows(nav):
+        tops.append(float(np.nanmax(-col(nav, "down"))) * k)
+    top = 1.3 * max(tops) if tops else ax.get_ylim()[1]
+    ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]), top=min(ax.get_ylim()[1], top))
 
 
 def panel_speed(ax, k, nav, summary, gate_times):
@@ -296,7 +307,7 @@ def main():
 
     panel_top_view(ax_top, k, nav, ctl, wps, summary, gpath, ref, scan, cuboids)
     ax_top.set(xlabel="x (north) [%s]" % unit, ylabel="y (east) [%s]" % unit, title="top view")
-    panel_altitude(ax_alt, k, nav, ctl, wps, summary, cuboids)
+    panel_altitude(ax_alt, k, nav, ctl, wps, summary, cuboids, scan)
     ax_alt.set(xlabel="x (north) [%s]" % unit, ylabel="h [%s]" % unit, title="altitude")
     panel_speed(ax_spd, k, nav, summary, gate_times)
     ax_spd.set(xlabel="t [s]", ylabel="speed [%s/s]" % unit, title="speed")

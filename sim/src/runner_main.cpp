@@ -14,7 +14,10 @@
 #include "ofn/common/scenario.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/controller/controller_service.hpp"
+#include "ofn/mapper/mapper_service.hpp"
 #include "ofn/mission_uplink/mission_uplink_service.hpp"
+#include "ofn/obstacle_injector/obstacle_injector_service.hpp"
+#include "ofn/sensor_interface/sensor_interface_service.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/tools/flight_report.hpp"
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
@@ -39,7 +42,8 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--config-dir", config_dir,
-                 "folder with vehicle_sim.yaml and controller.yaml (missing files: defaults)");
+                 "folder with the services' config files, e.g. vehicle_sim.yaml and "
+                 "mapper.yaml (missing files: defaults)");
   app.add_option("--out", out_dir, "folder for the log, CSV files and summary (default: none)");
   app.add_option("--log", log_path, "LCM log to write (default: <out>/flight.lcm)");
   app.add_option("--max-time", max_time, "simulated seconds before giving up (default: scenario)")
@@ -58,6 +62,13 @@ int main(int argc, char** argv) {
     auto controller_reader = config_in(config_dir, "controller.yaml");
     const auto vehicle_config = ofn::vehicle::load_vehicle_sim_config(vehicle_reader);
     const auto controller_config = ofn::control::load_controller_config(controller_reader);
+    auto injector_reader = config_in(config_dir, "obstacle_injector.yaml");
+    auto sensor_reader = config_in(config_dir, "sensor_interface.yaml");
+    auto mapper_reader = config_in(config_dir, "mapper.yaml");
+    const auto injector_config =
+        ofn::injector::load_obstacle_injector_config(injector_reader);
+    const auto sensor_config = ofn::sensing::load_sensor_interface_config(sensor_reader);
+    const auto mapper_config = ofn::mapping::load_mapper_config(mapper_reader);
     if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
     if (log_path.empty() && !out_dir.empty()) log_path = out_dir + "/flight.lcm";
 
@@ -67,9 +78,13 @@ int main(int argc, char** argv) {
                                             vehicle_config);
     ofn::uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), scenario_path);
     ofn::control::ControllerService controller(lockstep.lcm(), lockstep.clock(), controller_config);
-    lockstep.add(vehicle.node());
-    lockstep.add(uplink.node());
-    lockstep.add(controller.node());
+    ofn::injector::ObstacleInjectorService injector(lockstep.lcm(), lockstep.clock(),
+                                                    scenario_path, injector_config);
+    ofn::sensing::SensorInterfaceService sensor(lockstep.lcm(), lockstep.clock(), sensor_config);
+    ofn::mapping::MapperService mapper(lockstep.lcm(), lockstep.clock(), mapper_config);
+    for (ofn::Node* node : {&vehicle.node(), &uplink.node(), &controller.node(), &injector.node(),
+                            &sensor.node(), &mapper.node()})
+      lockstep.add(*node);
 
     const double limit = max_time > 0 ? max_time : scenario.max_time;
     ofn::Utime done_at = INT64_MIN;

@@ -13,9 +13,12 @@
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/control_status_t.hpp"
+#include "ofn/cuboid_list_t.hpp"
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
+#include "ofn/scan_world_t.hpp"
+#include "ofn/world/world.hpp"
 
 namespace ofn::report {
 namespace {
@@ -34,6 +37,18 @@ std::ofstream open_csv(const std::filesystem::path& path, const std::string& hea
   if (!f) throw std::runtime_error("cannot write " + path.string());
   f << std::setprecision(10) << header << "\n";
   return f;
+}
+
+const char* kind_name(ObstacleSpec::Kind k) {
+  switch (k) {
+    case ObstacleSpec::Kind::kBox:
+      return "box";
+    case ObstacleSpec::Kind::kCylinder:
+      return "cylinder";
+    case ObstacleSpec::Kind::kTree:
+      return "tree";
+  }
+  return "box";
 }
 
 std::string json_number(std::optional<double> v) {
@@ -70,6 +85,13 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   auto hb_csv = open_csv(out / "heartbeats.csv",
                          "t,service,state,received,rejected,late,loop_time_mean,loop_time_max,"
                          "cpu_fraction");
+  // Every scan point of a long flight would make a plot unreadable and a
+  // file of hundreds of MB: keep every n-th point, up to a budget.
+  constexpr size_t kScanPointStride = 7;
+  constexpr size_t kMaxScanPoints = 300000;
+  auto scan_csv = open_csv(out / "scan_points.csv", "t,north,east,down");
+  size_t scan_points_seen = 0, scan_points_written = 0;
+  std::optional<cuboid_list_t> last_cuboids;
   auto row = [](std::ofstream& f, std::initializer_list<Vec3> vs) {
     for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
   };
@@ -117,6 +139,19 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       if (!decode(e, m)) return false;
       cmd_csv << rel(m.utime) << "," << m.collective << "," << m.lon_cyclic << "," << m.lat_cyclic
               << "," << m.pedal << "\n";
+    } else if (channel == channels::kScanWorld) {
+      scan_world_t m{};
+      if (!decode(e, m)) return false;
+      for (const auto& p : m.points) {
+        if (scan_points_seen++ % kScanPointStride != 0 || scan_points_written >= kMaxScanPoints)
+          continue;
+        ++scan_points_written;
+        scan_csv << rel(m.utime) << "," << p[0] << "," << p[1] << "," << p[2] << "\n";
+      }
+    } else if (channel == channels::kCuboids) {
+      cuboid_list_t m{};
+      if (!decode(e, m)) return false;
+      last_cuboids = std::move(m);
     } else if (channel == channels::kMission) {
       mission_t m{};
       if (!decode(e, m)) return false;
@@ -169,6 +204,32 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   } else {
     open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
   }
+  {
+    // The obstacle database as it stood at the end of the flight.
+    auto cuboid_csv = open_csv(out / "cuboids.csv",
+                               "t,id,min_n,min_e,min_d,max_n,max_e,max_d,top_observed,confidence");
+    if (last_cuboids)
+      for (const auto& c : last_cuboids->cuboids)
+        cuboid_csv << rel(last_cuboids->utime) << "," << c.id << "," << c.min_corner[0] << ","
+                   << c.min_corner[1] << "," << c.min_corner[2] << "," << c.max_corner[0] << ","
+                   << c.max_corner[1] << "," << c.max_corner[2] << ","
+                   << (c.top_observed ? 1 : 0) << "," << c.confidence << "\n";
+  }
+  // True clearance: distance from the flown path to the real obstacle
+  // surfaces (present at that time), over the whole flight.
+  std::optional<double> min_clearance;
+  std::optional<double> min_clearance_t;
+  if (scenario && !scenario->obstacles.empty()) {
+    const world::World truth(scenario->obstacles, scenario->ground_altitude);
+    for (const auto& n : nav) {
+      const double d = truth.distance_to_obstacles(n.position, n.t);
+      if (!min_clearance || d < *min_clearance) {
+        min_clearance = d;
+        min_clearance_t = n.t;
+      }
+    }
+  }
+  result.min_clearance = min_clearance;
   const auto start_gate = scenario ? scenario->start_gate : std::nullopt;
   const auto finish_gate = scenario ? scenario->finish_gate : std::nullopt;
   result.summary = analyse_flight(nav, status, limits, start_gate, finish_gate);
@@ -202,8 +263,24 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"max_pseudo_control\": " << s.max_pseudo_control << ",\n"
        << "  \"tracking_rms\": " << s.tracking_rms << ",\n"
        << "  \"tracking_max\": " << s.tracking_max << ",\n"
-       << "  \"obstacles\": []\n"
-       << "}\n";
+       << "  \"min_clearance\": " << json_number(min_clearance) << ",\n"
+       << "  \"min_clearance_t\": " << json_number(min_clearance_t) << ",\n"
+       << "  \"clearance_required\": " << limits.clearance << ",\n"
+       << "  \"obstacles\": [";
+  if (scenario) {
+    // Metres, like every other length in this file (the plot scales them).
+    const auto& obs = scenario->obstacles;
+    for (size_t i = 0; i < obs.size(); ++i) {
+      const auto& o = obs[i];
+      json << (i ? ",\n    " : "\n    ") << "{\"id\": " << o.id << ", \"kind\": \""
+           << kind_name(o.kind) << "\", \"center\": [" << o.north << ", " << o.east
+           << "], \"size\": [" << o.length << ", " << o.width << "], \"height\": " << o.height
+           << ", \"yaw\": " << o.yaw << ", \"appear_time\": " << o.appear_time
+           << ", \"disappear_time\": " << o.disappear_time << "}";
+    }
+    if (!obs.empty()) json << "\n  ";
+  }
+  json << "]\n}\n";
 
   std::ostringstream t;
   t << std::fixed << std::setprecision(2);
@@ -229,10 +306,16 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     << "/s^2 (command plus feedback corrections)\n";
   t << "  tracking error    : RMS " << s.tracking_rms / k << " " << unit << ", max "
     << s.tracking_max / k << " " << unit << "\n";
+  if (min_clearance)
+    t << "  least clearance   : " << *min_clearance / k << " " << unit << " to a real obstacle at t = "
+      << *min_clearance_t << " s (required " << limits.clearance / k << ")\n";
+  if (last_cuboids)
+    t << "  obstacle database : " << last_cuboids->num_cuboids << " cuboids at the end, "
+      << scan_points_seen << " LIDAR points mapped\n";
   if (result.undecodable)
     t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
   t << "  files             : " << out.string() << "/{nav_state,control_status,actuator_cmd,"
-    << "heartbeats,waypoints}.csv, summary.json\n";
+    << "heartbeats,waypoints,scan_points,cuboids}.csv, summary.json\n";
   result.text = t.str();
   std::ofstream(out / "summary.txt") << result.text;
   return result;

@@ -16,6 +16,9 @@ struct ReportResult {
   std::string text;  // one-screen summary for the terminal
   size_t events = 0;
   size_t undecodable = 0;
+  /// Least distance from the flown path to a real obstacle (m); none
+  /// without a scenario or obstacles.
+  std::optional<double> min_clearance;
 };
 
 /// Reads `log_path`, writes CSV and summary files into `out_dir` (created if
