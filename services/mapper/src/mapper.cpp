@@ -110,31 +110,37 @@ bool Mapper::rectangle_top_seen(double min_n, double min_e, double max_n, double
   return false;
 }
 
+template <class Visit>
+void Mapper::for_each_column_top(double min_probability, Visit visit) const {
+  // Altitudes of the occupancy queries are above the ground, like the grid's.
+  const Heightfield& raw = grid_.raw();
+  const double voxel = config_.occupancy.resolution;
+  const double half = 0.5 * raw.resolution;
+  for (int r = 0; r < raw.rows; ++r)
+    for (int c = 0; c < raw.cols; ++c) {
+      const float top = raw.at(r, c);
+      if (top <= 0.0f) continue;
+      visit(r, c, top,
+            occupancy_.column_top(raw.cell_centre_north(r), raw.cell_centre_east(c), half,
+                                  config_.grid.ground_clearance, top + voxel, min_probability));
+    }
+}
+
 void Mapper::reconcile_with_occupancy() {
   // A grid cell keeps its highest hit for ever in the paper's design. Here
   // the occupancy map has the last word: where beams have since passed
   // through the space a hit claimed, the cell comes down to what is still
   // occupied (nothing, for a false return or a removed obstacle).
-  const Heightfield& raw = grid_.raw();
   const double voxel = config_.occupancy.resolution;
-  const double half = 0.5 * raw.resolution;
-  for (int r = 0; r < raw.rows; ++r) {
-    for (int c = 0; c < raw.cols; ++c) {
-      const float top = raw.at(r, c);
-      if (top <= 0.0f) continue;
-      // Altitudes of the occupancy queries are above the ground, like the grid's.
-      const double occupied_above_ground =
-          occupancy_.column_top(raw.cell_centre_north(r), raw.cell_centre_east(c), half,
-                                config_.grid.ground_clearance, top + voxel);
-      if (occupied_above_ground < 0) {
-        grid_.lower_cell(r, c, 0.0f);
-        ++counters_.cells_lowered;
-      } else if (occupied_above_ground < top - voxel) {
-        grid_.lower_cell(r, c, static_cast<float>(occupied_above_ground));
-        ++counters_.cells_lowered;
-      }
+  for_each_column_top(0.0, [&](int r, int c, float top, double occupied_top) {
+    if (occupied_top < 0) {
+      grid_.lower_cell(r, c, 0.0f);
+      ++counters_.cells_lowered;
+    } else if (occupied_top < top - voxel) {
+      grid_.lower_cell(r, c, static_cast<float>(occupied_top));
+      ++counters_.cells_lowered;
     }
-  }
+  });
 }
 
 Heightfield Mapper::confirmed_grid() {
@@ -143,22 +149,11 @@ Heightfield Mapper::confirmed_grid() {
   // (conservative for the optimiser) but must be seen again before it can
   // become an obstacle in the database.
   confirmed_ = grid_;
-  const Heightfield& raw = grid_.raw();
-  const double voxel = config_.occupancy.resolution;
-  const double half = 0.5 * raw.resolution;
-  for (int r = 0; r < raw.rows; ++r) {
-    for (int c = 0; c < raw.cols; ++c) {
-      const float top = raw.at(r, c);
-      if (top <= 0.0f) continue;
-      const double confirmed_top = occupancy_.column_top(
-          raw.cell_centre_north(r), raw.cell_centre_east(c), half, config_.grid.ground_clearance,
-          top + voxel, config_.confirm_probability);
-      if (confirmed_top < 0)
-        confirmed_.lower_cell(r, c, 0.0f);
-      else
-        confirmed_.lower_cell(r, c, static_cast<float>(std::min<double>(top, confirmed_top)));
-    }
-  }
+  for_each_column_top(config_.confirm_probability, [&](int r, int c, float top,
+                                                       double confirmed_top) {
+    confirmed_.lower_cell(
+        r, c, confirmed_top < 0 ? 0.0f : static_cast<float>(std::min<double>(top, confirmed_top)));
+  });
   return confirmed_.filtered();
 }
 

@@ -71,6 +71,11 @@ class Mapper {
   const ObstacleDatabase& database() const { return database_; }
 
  private:
+  /// Calls visit(row, col, top, occupied_top) for every occupied grid
+  /// cell, with the highest voxel top of its column that reaches
+  /// min_probability (negative: none).
+  template <class Visit>
+  void for_each_column_top(double min_probability, Visit visit) const;
   void reconcile_with_occupancy();
   Heightfield confirmed_grid();
   /// Marks the cells whose top the beam from `origin` to `end` passed over.
