@@ -14,7 +14,6 @@
 #include "ofn/common/frames.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/mapper/mapper.hpp"
-#include "ofn/obstacle_injector/obstacle_injector_service.hpp"
 #include "ofn/sensor_interface/pose_buffer.hpp"
 #include "ofn/sensor_interface/scan_processor.hpp"
 #include "ofn/vehicle_sim/lidar_head.hpp"
@@ -105,7 +104,7 @@ using ScanHook = std::function<void(mapping::Mapper&, double t)>;
 std::vector<ObstacleSpec> present_at(const std::vector<ObstacleSpec>& all, double t) {
   std::vector<ObstacleSpec> present;
   for (const auto& o : all)
-    if (injector::present_at(o, t)) present.push_back(o);
+    if (o.present_at(t)) present.push_back(o);
   return present;
 }
 

@@ -307,14 +307,14 @@ TEST_F(ObstacleInjector, BadScenarioAtStartIsAConfigError) {
 
 TEST(ObstacleInjectorSchedule, PresentFromAppearUntilBeforeDisappear) {
   ObstacleSpec o;
-  EXPECT_TRUE(injector::present_at(o, 0.0));
-  EXPECT_TRUE(injector::present_at(o, 1e6));
+  EXPECT_TRUE(o.present_at(0.0));
+  EXPECT_TRUE(o.present_at(1e6));
   o.appear_time = 2.0;
   o.disappear_time = 5.0;
-  EXPECT_FALSE(injector::present_at(o, 1.999));
-  EXPECT_TRUE(injector::present_at(o, 2.0));
-  EXPECT_TRUE(injector::present_at(o, 4.999));
-  EXPECT_FALSE(injector::present_at(o, 5.0));
+  EXPECT_FALSE(o.present_at(1.999));
+  EXPECT_TRUE(o.present_at(2.0));
+  EXPECT_TRUE(o.present_at(4.999));
+  EXPECT_FALSE(o.present_at(5.0));
 }
 
 TEST(ObstacleInjectorConfig, DefaultsAndErrorsNameTheField) {

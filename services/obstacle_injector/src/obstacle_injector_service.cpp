@@ -36,12 +36,6 @@ ObstacleInjectorConfig load_obstacle_injector_config(YamlReader& r) {
   return c;
 }
 
-bool present_at(const ObstacleSpec& o, double t) {
-  const bool appeared = o.appear_time < 0 || o.appear_time <= t;
-  const bool removed = o.disappear_time >= 0 && t >= o.disappear_time;
-  return appeared && !removed;
-}
-
 ObstacleInjectorService::ObstacleInjectorService(lcm::LCM& lcm, const Clock& clock,
                                                  std::string scenario_path,
                                                  ObstacleInjectorConfig config)
@@ -86,7 +80,7 @@ void ObstacleInjectorService::check() {
   const double t = to_seconds(now - mission_start_);
   std::vector<int> ids;
   for (const auto& o : scenario_.obstacles)
-    if (present_at(o, t)) ids.push_back(o.id);
+    if (o.present_at(t)) ids.push_back(o.id);
   std::sort(ids.begin(), ids.end());
 
   const bool set_changed = ids != present_ids_;

@@ -277,12 +277,6 @@ Obstacle::Obstacle(const ObstacleSpec& spec, double ground_altitude)
   }
 }
 
-bool Obstacle::present_at(double t) const {
-  if (spec_.appear_time >= 0 && t < spec_.appear_time) return false;
-  if (spec_.disappear_time >= 0 && t >= spec_.disappear_time) return false;
-  return true;
-}
-
 std::optional<double> Obstacle::ray_cast(const Vec3& origin, const Vec3& unit_dir,
                                          double max_range) const {
   if (!hits_aabb(bounds_min_, bounds_max_, origin, unit_dir, max_range)) return std::nullopt;

@@ -25,15 +25,21 @@ struct Limits {
 struct ObstacleSpec {
   enum class Kind { kBox, kCylinder, kTree };
   Kind kind = Kind::kBox;
-  int id = 0;                        // unique within the scenario, from 1
-  double north = 0, east = 0;        // m, centre of the footprint
-  double length = 0, width = 0;      // m; box: along its x / y; cylinder: diameter, diameter;
-                                     // tree: canopy extent along north / east
-  double height = 0;                 // m above ground (tree: canopy top)
-  double yaw = 0;                    // rad from north, positive to the east (boxes only)
-  int seed = 0;                      // tree canopy shape
-  double appear_time = -1;           // s after the start; negative: present from the start
-  double disappear_time = -1;        // s after the start; negative: never removed
+  int id = 0;                    // unique within the scenario, from 1
+  double north = 0, east = 0;    // m, centre of the footprint
+  double length = 0, width = 0;  // m; box: along its x / y; cylinder: diameter, diameter;
+                                 // tree: canopy extent along north / east
+  double height = 0;             // m above ground (tree: canopy top)
+  double yaw = 0;                // rad from north, positive to the east (boxes only)
+  int seed = 0;                  // tree canopy shape
+  double appear_time = -1;       // s after the start; negative: present from the start
+  double disappear_time = -1;    // s after the start; negative: never removed
+
+  /// Present at t (s after the start): from appear_time (inclusive) until
+  /// disappear_time (exclusive).
+  bool present_at(double t) const {
+    return (appear_time < 0 || t >= appear_time) && (disappear_time < 0 || t < disappear_time);
+  }
 };
 
 struct Waypoint {

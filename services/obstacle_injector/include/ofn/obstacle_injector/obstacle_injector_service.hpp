@@ -23,10 +23,6 @@ struct ObstacleInjectorConfig {
 /// Reads the config fields (all optional); throws ConfigError naming the field.
 ObstacleInjectorConfig load_obstacle_injector_config(YamlReader& reader);
 
-/// Whether `obstacle` is present at `mission_time` (s): from appear_time
-/// (inclusive) to disappear_time (exclusive); negative times are unbounded.
-bool present_at(const ObstacleSpec& obstacle, double mission_time);
-
 class ObstacleInjectorService {
  public:
   /// A bad scenario at start throws ConfigError; later bad edits keep the

@@ -26,7 +26,7 @@ class Obstacle {
 
   const ObstacleSpec& spec() const { return spec_; }
   /// Present at time t (s after the start), honouring appear/disappear times.
-  bool present_at(double t) const;
+  bool present_at(double t) const { return spec_.present_at(t); }
 
   /// Distance along the unit ray to the first surface point at or beyond
   /// the origin (0 when the origin is inside), if within max_range.
