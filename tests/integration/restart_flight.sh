@@ -8,7 +8,9 @@ source "$(dirname "$0")/common.sh"
 launcher=$!
 # Wait until the vehicle is well into the flight (about 20 s of flight time).
 sleep 6
-pkill -KILL -f "$BIN/ofn_controller" || fail "no controller process to kill"
+# Only this launcher's controller: tests run side by side share the process
+# table (the network namespace is private, the PID namespace is not).
+pkill -KILL -P $launcher -f "$BIN/ofn_controller" || fail "no controller process to kill"
 echo "killed the controller"
 wait $launcher || { tail -40 "$WORK/launch.txt"; fail "launcher exit code $?"; }
 grep -qi "controller exited" "$WORK/launch.txt" || fail "launcher did not notice the controller exit"
