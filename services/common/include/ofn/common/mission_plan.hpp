@@ -1,0 +1,104 @@
+#pragma once
+// The uplinked plan as the planners see it: waypoints and limits in SI from
+// MISSION, and which leg the vehicle is on. The controller's waypoint
+// guidance owns the reference it flies; the planners only need to know the
+// leg (previous waypoint -> target) to set up the guidance frame, by the
+// same rule: start on the leg nearest the vehicle, move on inside a
+// waypoint's capture radius or once past the waypoint along the leg.
+
+#include <algorithm>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "ofn/common/frames.hpp"
+#include "ofn/common/scenario.hpp"
+#include "ofn/mission_t.hpp"
+
+namespace ofn {
+
+/// The message must have passed validate(mission_t).
+inline std::vector<Waypoint> waypoints_from(const mission_t& m) {
+  std::vector<Waypoint> out;
+  for (const auto& w : m.waypoints)
+    out.push_back({Vec3(w.position[0], w.position[1], w.position[2]), w.capture_radius});
+  return out;
+}
+
+inline Limits limits_from(const limits_t& l) {
+  return Limits{l.max_speed,         l.max_accel, l.max_vertical_speed,
+                l.min_forward_speed, l.clearance, l.sensor_range};
+}
+
+struct ActiveLeg {
+  Vec3 from = Vec3::Zero();  // previous waypoint (or where the plan was picked up)
+  Vec3 to = Vec3::Zero();    // the waypoint flown to
+  int index = -1;            // index of `to` in the plan
+  bool final = false;        // `to` is the last waypoint
+};
+
+class LegTracker {
+ public:
+  /// Starts a plan at the leg nearest `position` (ties go to the later leg).
+  void set_plan(std::vector<Waypoint> waypoints, const Vec3& position) {
+    waypoints_ = std::move(waypoints);
+    active_ = -1;
+    if (waypoints_.empty()) return;
+    if (waypoints_.size() == 1) {
+      active_ = 0;
+      single_from_ = position;
+      return;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 1; i < waypoints_.size(); ++i) {
+      const double d = distance_to_segment(position, waypoints_[i - 1].position,
+                                           waypoints_[i].position);
+      if (d <= best) {
+        best = d;
+        active_ = static_cast<int>(i);
+      }
+    }
+  }
+
+  void clear() {
+    waypoints_.clear();
+    active_ = -1;
+  }
+  bool has_plan() const { return active_ >= 0; }
+
+  /// Moves on past every waypoint captured or passed; the leg now flown.
+  std::optional<ActiveLeg> update(const Vec3& position) {
+    if (active_ < 0) return std::nullopt;
+    while (active_ + 1 < static_cast<int>(waypoints_.size()) && reached(position)) ++active_;
+    ActiveLeg leg;
+    leg.index = active_;
+    leg.to = waypoints_[active_].position;
+    leg.from = active_ > 0 ? waypoints_[active_ - 1].position : single_from_;
+    leg.final = active_ + 1 == static_cast<int>(waypoints_.size());
+    return leg;
+  }
+
+ private:
+  static double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+    const Vec3 ab = b - a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    return (a + t * ab - p).norm();
+  }
+
+  bool reached(const Vec3& position) const {
+    const Waypoint& target = waypoints_[active_];
+    if ((position - target.position).norm() <= target.capture_radius) return true;
+    if (active_ == 0) return false;
+    const Vec3 from = waypoints_[active_ - 1].position;
+    const Vec3 leg = target.position - from;
+    const double length = leg.norm();
+    return length > 1e-9 && (position - from).dot(leg / length) >= length;
+  }
+
+  std::vector<Waypoint> waypoints_;
+  int active_ = -1;
+  Vec3 single_from_ = Vec3::Zero();
+};
+
+}  // namespace ofn
