@@ -29,3 +29,10 @@ median=$(sed -n 3p <<< "$sorted")
   echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
   echo "lockstep real-time factor, open course (median of 5): ${median}x (goal >= 50x)"
 } | tee "$out/lockstep.txt"
+
+echo
+echo "== tracking sweep: adaptive vs non-adaptive (airframe errors x crosswinds) =="
+"$build/bin/ofn_tracking_sweep" --out "$out" | tail -n 1
+cat "$out/tracking_sweep.md"
+python3 "$repo/bench/plot_tracking_sweep.py" "$out/tracking_sweep.csv" "$out/tracking_sweep.png" ||
+  echo "(plot skipped: python3 with matplotlib needed)"

@@ -252,7 +252,7 @@ TEST(RotorcraftModel, ServoRateLimitBoundsActuatorMotion) {
   fly(model, 0.02);
   const double moved = model.state().actuators.lon_cyclic - before;
   EXPECT_GT(moved, 0.0);
-  EXPECT_LE(moved, p.actuator_rate * 0.02 + 1e-9);
+  EXPECT_LE(moved, p.actuator_rate.lon_cyclic * 0.02 + 1e-9);
 }
 
 TEST(RotorcraftModel, SteadyHoverInflowMatchesMomentumTheory) {

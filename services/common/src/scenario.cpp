@@ -74,12 +74,85 @@ ObstacleSpec read_obstacle(YamlReader& o, size_t index, double metres_per_unit) 
   return spec;
 }
 
+void read_vehicle(YamlReader& v, Scenario& s) {
+  VehicleVariation& out = s.vehicle;
+  out.mass_scale = v.number_in("mass_scale", 1.0, 0.2, 5.0);
+  const auto inertia = v.numbers("inertia_scale", {1.0, 1.0, 1.0});
+  for (double i : inertia)
+    if (!(i >= 0.2 && i <= 5.0)) v.fail("inertia_scale", "every scale must lie in [0.2, 5]");
+  out.inertia_scale = Vec3(inertia[0], inertia[1], inertia[2]);
+  out.actuator_time_scale = v.number_in("actuator_time_scale", 1.0, 0.2, 10.0);
+  YamlReader lim = v.child("actuator_limits");
+  if (lim.has("collective_deg")) {
+    const auto c = lim.numbers("collective_deg", 2);
+    if (!(c[0] < c[1])) lim.fail("collective_deg", "expected [min, max] with min < max");
+    out.collective_min = deg2rad(c[0]);
+    out.collective_max = deg2rad(c[1]);
+  }
+  auto optional_angle = [&](const char* key, double hi, std::optional<double>& dst) {
+    if (lim.has(key)) dst = deg2rad(lim.number_in(key, 0.0, 0.01, hi));
+  };
+  optional_angle("cyclic_deg", 45.0, out.cyclic_limit);
+  optional_angle("pedal_deg", 60.0, out.pedal_limit);
+  optional_angle("collective_rate_deg_s", 10000.0, out.collective_rate);
+  optional_angle("cyclic_rate_deg_s", 10000.0, out.cyclic_rate);
+  optional_angle("pedal_rate_deg_s", 10000.0, out.pedal_rate);
+  lim.finish();
+  v.finish();
+}
+
+void read_disturbances(YamlReader& d, Scenario& s) {
+  const double k = s.metres_per_unit;
+  Disturbances& out = s.disturbances;
+  constexpr double kKnot = 1852.0 / 3600.0;
+  // MIL-F-8785C: wind speed at 20 ft for light, moderate and severe turbulence.
+  const std::string level = d.text("turbulence", "none");
+  if (level == "none") {
+    out.turbulence.wind_at_20ft = 0;
+  } else if (level == "light") {
+    out.turbulence.wind_at_20ft = 15 * kKnot;
+  } else if (level == "moderate") {
+    out.turbulence.wind_at_20ft = 30 * kKnot;
+  } else if (level == "severe") {
+    out.turbulence.wind_at_20ft = 45 * kKnot;
+  } else {
+    d.fail("turbulence", "expected none, light, moderate or severe, got '" + level + "'");
+  }
+  auto non_negative_vec = [&](const char* key, double scale) -> Vec3 {
+    const auto v = d.numbers(key, 3);
+    for (double x : v)
+      if (!(x >= 0)) d.fail(key, "every component must be >= 0");
+    return Vec3(v[0], v[1], v[2]) * scale;
+  };
+  if (d.has("turbulence_sigma")) {
+    if (level != "none") d.fail("turbulence_sigma", "give a turbulence level or sigma, not both");
+    out.turbulence.sigma = non_negative_vec("turbulence_sigma", k);
+  }
+  if (d.has("turbulence_scale")) {
+    const Vec3 scale = non_negative_vec("turbulence_scale", k);
+    if (!(scale.minCoeff() > 0)) d.fail("turbulence_scale", "every scale length must be > 0");
+    out.turbulence.scale_length = scale;
+  }
+  YamlReader nav = d.child("nav_noise");
+  out.nav.position_sigma = nav.number_in("position", 0.0, 0.0, 1e3) * k;
+  out.nav.velocity_sigma = nav.number_in("velocity", 0.0, 0.0, 1e3) * k;
+  out.nav.attitude_sigma = deg2rad(nav.number_in("attitude_deg", 0.0, 0.0, 30.0));
+  out.nav.rate_sigma = deg2rad(nav.number_in("rate_deg_s", 0.0, 0.0, 100.0));
+  out.nav.latency = nav.number_in("latency", 0.0, 0.0, 1.0);
+  nav.finish();
+  const int seed = d.integer("seed", 1);
+  if (seed < 0) d.fail("seed", "expected a whole number >= 0");
+  out.seed = static_cast<uint32_t>(seed);
+  d.finish();
+}
+
 }  // namespace
 
 Scenario load_scenario(const std::string& path) {
   YamlReader root = YamlReader::load_file(path);
   root.expect_only({"name", "description", "units", "start", "waypoints", "capture_radius",
-                    "cruise_speed", "limits", "gates", "environment", "obstacles", "max_time"});
+                    "cruise_speed", "limits", "gates", "environment", "obstacles", "max_time",
+                    "vehicle", "disturbances"});
   Scenario s;
   s.file = path;
   s.name = root.text("name");
@@ -158,6 +231,10 @@ Scenario load_scenario(const std::string& path) {
   }
 
   s.max_time = root.number_in("max_time", 600.0, 1.0, 1e6);
+  YamlReader vehicle = root.child("vehicle");
+  read_vehicle(vehicle, s);
+  YamlReader disturbances = root.child("disturbances");
+  read_disturbances(disturbances, s);
   root.finish();
   return s;
 }

@@ -42,6 +42,10 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.gains.max_vertical_accel =
       outer.number_in("max_vertical_accel", c.gains.max_vertical_accel, 0.1, 20.0);
   c.gains.max_tilt = deg2rad(outer.number_in("max_tilt_deg", rad2deg(c.gains.max_tilt), 1.0, 60.0));
+  c.gains.outer_reference_frequency =
+      outer.number_in("reference_frequency", c.gains.outer_reference_frequency, 0.05, 20.0);
+  c.gains.outer_reference_damping =
+      outer.number_in("reference_damping", c.gains.outer_reference_damping, 0.1, 5.0);
   outer.finish();
   YamlReader inner = r.child("inner_loop");
   c.gains.attitude = read_vec3(inner, "attitude_gain", c.gains.attitude);
@@ -49,7 +53,30 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.gains.attitude_integral = read_vec3(inner, "integral_gain", c.gains.attitude_integral);
   c.gains.attitude_integral_limit =
       inner.number_in("integral_limit", c.gains.attitude_integral_limit, 0.0, 100.0);
+  c.gains.inner_reference_frequency =
+      inner.number_in("reference_frequency", c.gains.inner_reference_frequency, 0.5, 100.0);
+  c.gains.inner_reference_damping =
+      inner.number_in("reference_damping", c.gains.inner_reference_damping, 0.1, 5.0);
   inner.finish();
+  YamlReader adaptive = r.child("adaptive");
+  c.adaptive.enabled = adaptive.boolean("enabled", c.adaptive.enabled);
+  c.gains.hedging = adaptive.boolean("hedging", c.gains.hedging);
+  const int seed = adaptive.integer("seed", static_cast<int>(c.adaptive.seed));
+  if (seed < 0) adaptive.fail("seed", "expected a whole number >= 0");
+  c.adaptive.seed = static_cast<uint32_t>(seed);
+  for (auto [key, net] : {std::pair<const char*, NetworkSettings*>{"outer", &c.adaptive.outer},
+                          std::pair<const char*, NetworkSettings*>{"inner", &c.adaptive.inner}}) {
+    YamlReader n = adaptive.child(key);
+    net->hidden = n.integer("hidden", net->hidden);
+    if (net->hidden < 1 || net->hidden > 64) n.fail("hidden", "expected 1 to 64 neurons");
+    net->output_rate = n.number_in("output_rate", net->output_rate, 0.0, 1e4);
+    net->hidden_rate = n.number_in("hidden_rate", net->hidden_rate, 0.0, 1e4);
+    net->e_modification = n.number_in("e_modification", net->e_modification, 0.0, 100.0);
+    net->max_weight_norm = n.number_in("max_weight_norm", net->max_weight_norm, 0.1, 1e4);
+    net->max_output = n.number_in("max_output", net->max_output, 0.0, 1e3);
+    n.finish();
+  }
+  adaptive.finish();
   YamlReader guidance = r.child("guidance");
   c.guidance.accel_fraction =
       guidance.number_in("accel_fraction", c.guidance.accel_fraction, 0.05, 1.0);
@@ -64,8 +91,7 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.sweep.frequency = sweep.number_in("frequency_hz", c.sweep.frequency, 0.01, 5.0);
   c.sweep.total_angle =
       deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
-  c.sweep.scanner_timeout =
-      sweep.number_in("scanner_timeout", c.sweep.scanner_timeout, 0.05, 60.0);
+  c.sweep.scanner_timeout = sweep.number_in("scanner_timeout", c.sweep.scanner_timeout, 0.05, 60.0);
   sweep.finish();
   YamlReader nominal = r.child("nominal_airframe");
   c.nominal.mass = nominal.number_in("mass", c.nominal.mass, 1.0, 1e4);
@@ -94,7 +120,7 @@ std::optional<Reference> sample_ref_traj(const ref_traj_t& traj, Utime now) {
 ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, ControllerConfig config)
     : node_("controller", lcm, clock),
       config_(std::move(config)),
-      controller_(config_.nominal, config_.gains),
+      controller_(config_.nominal, config_.gains, make_adaptive_element(config_.adaptive)),
       guidance_(config_.guidance) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
@@ -138,8 +164,8 @@ double ControllerService::yaw_reference(const Vec3& leg_direction, double* yaw_r
   double yaw = path_yaw_;
   *yaw_rate = 0;
   const Utime now = node_.now();
-  const bool scanner_on = last_scan_ != INT64_MIN &&
-                          now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
+  const bool scanner_on =
+      last_scan_ != INT64_MIN && now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
   if (!(config_.sweep.enabled && scanner_on && mode_ != control_status_t::HOLD)) {
     if (sweep_since_ != INT64_MIN) node_.log().info("yaw sweep stopped");
     sweep_since_ = INT64_MIN;

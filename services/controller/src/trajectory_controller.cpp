@@ -29,12 +29,26 @@ TrajectoryController::TrajectoryController(vehicle::RotorcraftParams nominal, Co
   hover_.lat_cyclic = 0;
   hover_tail_thrust_ = -model_.params().tail_thrust_per_rad * trim.controls.pedal;
   tail_thrust_estimate_ = hover_tail_thrust_;
+  actuator_estimate_ = hover_;
+  // Lyapunov weights of each axis's error dynamics e'' = -kp e - kd e',
+  // A^T P + P A = -I: e^T P B = p12 e + p22 e'.
+  auto lyapunov = [](const Vec3& kp, const Vec3& kd, Vec3* p12, Vec3* p22) {
+    for (int i = 0; i < 3; ++i) {
+      const double a = std::max(kp[i], 1e-3), b = std::max(kd[i], 1e-3);
+      (*p12)[i] = 1.0 / (2.0 * a);
+      (*p22)[i] = ((*p12)[i] + 0.5) / b;
+    }
+  };
+  lyapunov(gains_.position, gains_.velocity, &outer_p12_, &outer_p22_);
+  lyapunov(gains_.attitude, gains_.rate, &inner_p12_, &inner_p22_);
 }
 
 void TrajectoryController::reset() {
   position_integral_.setZero();
   attitude_integral_.setZero();
   tail_thrust_estimate_ = hover_tail_thrust_;
+  reference_started_ = false;
+  actuator_estimate_ = hover_;
   adaptive_->reset();
 }
 
@@ -59,6 +73,22 @@ double TrajectoryController::collective_for_thrust(double thrust, const Vec3& ai
   return (2.0 * ct / (p.lift_slope * p.solidity) + 0.5 * lambda) / (1.0 / 3.0 + 0.5 * mu * mu);
 }
 
+Vec3 TrajectoryController::angular_accel_for(const vehicle::Controls& c, double thrust,
+                                             const Vec3& air_body, const Vec3& w,
+                                             double rotor_torque) const {
+  const auto& p = model_.params();
+  const double moment_per_flap = thrust * p.hub_height + p.flap_stiffness;
+  const double flap_lon = p.cyclic_to_flap * c.lon_cyclic + p.flap_time_constant * w.y() -
+                          p.flap_blowback * air_body.x();
+  const double flap_lat = p.cyclic_to_flap * c.lat_cyclic - p.flap_time_constant * w.x() -
+                          p.flap_blowback * air_body.y();
+  const double tail_flow = air_body.y() - w.z() * p.tail_arm;
+  const double tail_thrust = -p.tail_thrust_per_rad * c.pedal - p.tail_velocity_damping * tail_flow;
+  const Vec3 moment(moment_per_flap * flap_lat, -moment_per_flap * flap_lon,
+                    rotor_torque - p.tail_arm * tail_thrust);
+  return (moment - w.cross(p.inertia.cwiseProduct(w))).cwiseQuotient(p.inertia);
+}
+
 ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEstimate& x,
                                          double dt) {
   const auto& p = model_.params();
@@ -68,10 +98,28 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   ad.dt = dt;
   ad.velocity = x.velocity;
   ad.body_rates = x.body_rates;
+  const Mat3 world_from_body = x.attitude.toRotationMatrix();
+  const Vec3 air_body = world_from_body.transpose() * x.velocity;
+  ad.body_velocity = air_body;
+  ad.gravity_body = world_from_body.transpose() * Vec3::UnitZ();
+  ad.nose_world = world_from_body.col(0);
+
+  if (!reference_started_) {
+    ref_position_ = x.position;
+    ref_velocity_ = x.velocity;
+    ref_attitude_ = x.attitude;
+    ref_rates_ = x.body_rates;
+    reference_started_ = true;
+  }
 
   // ---- Outer loop: translational pseudo-control (world NED) ----
-  ad.position_error = ref.position - x.position;
-  ad.velocity_error = ref.velocity - x.velocity;
+  // The reference model chases the commanded trajectory; the vehicle is
+  // made to follow the reference model.
+  const double wo = g.outer_reference_frequency;
+  const Vec3 rm_accel = ref.acceleration + wo * wo * (ref.position - ref_position_) +
+                        2.0 * g.outer_reference_damping * wo * (ref.velocity - ref_velocity_);
+  ad.position_error = ref_position_ - x.position;
+  ad.velocity_error = ref_velocity_ - x.velocity;
   for (int i = 0; i < 3; ++i) {
     // Anti-windup: integrate only near the reference (large errors are the
     // proportional term's job, and winding up on them overshoots), and keep
@@ -82,11 +130,15 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
       position_integral_[i] = std::clamp(position_integral_[i], -g.integral_limit / g.integral[i],
                                          g.integral_limit / g.integral[i]);
   }
-  ad.pseudo_accel = ref.acceleration + g.position.cwiseProduct(ad.position_error) +
+  ad.pseudo_accel = rm_accel + g.position.cwiseProduct(ad.position_error) +
                     g.velocity.cwiseProduct(ad.velocity_error) +
                     g.integral.cwiseProduct(position_integral_);
+  ad.outer_error_signal =
+      outer_p12_.cwiseProduct(ad.position_error) + outer_p22_.cwiseProduct(ad.velocity_error);
+  ad.outer_error_norm = std::hypot(ad.position_error.norm(), ad.velocity_error.norm());
   out.adaptive_accel = adaptive_->outer_output(ad);
-  Vec3 accel = ad.pseudo_accel - out.adaptive_accel;
+  const Vec3 accel_wanted = ad.pseudo_accel - out.adaptive_accel;
+  Vec3 accel = accel_wanted;
   const Vec3 horizontal = clamp_norm(Vec3(accel.x(), accel.y(), 0.0), g.max_horizontal_accel);
   const double vertical = std::clamp(accel.z(), -g.max_vertical_accel, g.max_vertical_accel);
   out.saturated =
@@ -96,12 +148,10 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
 
   // Invert: the main rotor must supply m (a - g) less the fuselage drag and
   // the tail rotor's side force (last step's value; it changes slowly).
-  const Mat3 world_from_body = x.attitude.toRotationMatrix();
-  const Vec3 air_body = world_from_body.transpose() * x.velocity;
   const Vec3 drag_body =
       -0.5 * p.air_density * p.drag_area.cwiseProduct(air_body.cwiseAbs()).cwiseProduct(air_body);
-  const Vec3 other_body = drag_body + Vec3(0.0, tail_thrust_estimate_, 0.0);
-  Vec3 force = p.mass * (accel - Vec3(0, 0, kGravity)) - world_from_body * other_body;
+  const Vec3 other_world = world_from_body * (drag_body + Vec3(0.0, tail_thrust_estimate_, 0.0));
+  Vec3 force = p.mass * (accel - Vec3(0, 0, kGravity)) - other_world;
   // Never ask for less than a fraction of hover thrust or a large tilt.
   if (force.z() > -0.3 * p.mass * kGravity) force.z() = -0.3 * p.mass * kGravity;
   const double max_horizontal = -force.z() * std::tan(g.max_tilt);
@@ -122,21 +172,31 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   out.controls.collective = collective_for_thrust(out.thrust, air_body);
 
   // ---- Inner loop: attitude pseudo-control (body axes) ----
-  Quat err = x.attitude.conjugate() * out.attitude_command;
-  if (err.w() < 0) err.coeffs() = -err.coeffs();  // shortest rotation
-  ad.attitude_error = 2.0 * err.vec();
+  auto rotation_error = [](const Quat& from, const Quat& to) {
+    Quat e = from.conjugate() * to;
+    if (e.w() < 0) e.coeffs() = -e.coeffs();  // shortest rotation
+    return Vec3(2.0 * e.vec());
+  };
+  const double wi = g.inner_reference_frequency;
   const Vec3 rate_command = Vec3(0, 0, ref.yaw_rate);
-  ad.rate_error = rate_command - x.body_rates;
+  const Vec3 rm_angular = wi * wi * rotation_error(ref_attitude_, out.attitude_command) +
+                          2.0 * g.inner_reference_damping * wi * (rate_command - ref_rates_);
+  ad.attitude_error = rotation_error(x.attitude, ref_attitude_);
+  ad.rate_error = ref_rates_ - x.body_rates;
   attitude_integral_ += ad.attitude_error * dt;
   for (int i = 0; i < 3; ++i)
     if (g.attitude_integral[i] > 0)
       attitude_integral_[i] =
           std::clamp(attitude_integral_[i], -g.attitude_integral_limit / g.attitude_integral[i],
                      g.attitude_integral_limit / g.attitude_integral[i]);
-  ad.pseudo_angular = g.attitude.cwiseProduct(ad.attitude_error) +
+  ad.pseudo_angular = rm_angular + g.attitude.cwiseProduct(ad.attitude_error) +
                       g.rate.cwiseProduct(ad.rate_error) +
                       g.attitude_integral.cwiseProduct(attitude_integral_);
-  const Vec3 angular = ad.pseudo_angular - adaptive_->inner_output(ad);
+  ad.inner_error_signal =
+      inner_p12_.cwiseProduct(ad.attitude_error) + inner_p22_.cwiseProduct(ad.rate_error);
+  ad.inner_error_norm = std::hypot(ad.attitude_error.norm(), ad.rate_error.norm());
+  out.adaptive_angular = adaptive_->inner_output(ad);
+  const Vec3 angular = ad.pseudo_angular - out.adaptive_angular;
   const Vec3& w = x.body_rates;
   const Vec3 moment = p.inertia.cwiseProduct(angular) + w.cross(p.inertia.cwiseProduct(w));
 
@@ -166,9 +226,8 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   const double tail_flow = air_body.y() - w.z() * p.tail_arm;
   out.controls.pedal = -(tail_thrust + p.tail_velocity_damping * tail_flow) / p.tail_thrust_per_rad;
 
-  adaptive_->update(ad);
-
   // Clamp to the actuator limits the controller knows of.
+  const vehicle::Controls unclamped = out.controls;
   const vehicle::Controls lo = p.min_controls, hi = p.max_controls;
   vehicle::Controls c = out.controls;
   c.collective = std::clamp(c.collective, lo.collective, hi.collective);
@@ -177,9 +236,55 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   c.pedal = std::clamp(c.pedal, lo.pedal, hi.pedal);
   if (c.as_array() != out.controls.as_array()) out.saturated = true;
   out.controls = c;
-  if (!finite(out.controls) || !out.commanded_accel.allFinite()) {
+
+  // ---- Hedging: what the model says the vehicle achieves with these
+  // controls, where the servos can have got to, and (outer loop) the
+  // attitude it has now rather than the one commanded.
+  auto reached = actuator_estimate_.as_array();
+  const auto wanted = c.as_array(), rate = p.actuator_rate.as_array();
+  for (int i = 0; i < 4; ++i)
+    reached[i] = std::clamp(wanted[i], reached[i] - rate[i] * dt, reached[i] + rate[i] * dt);
+  const auto achievable = vehicle::Controls::from_array(reached);
+  double thrust_achievable = out.thrust;
+  if (achievable.collective != unclamped.collective)
+    thrust_achievable =
+        model_.thrust(achievable.collective,
+                      model_.steady_induced_velocity(achievable.collective, air_body), air_body);
+  // The thrust points along the inner reference model's attitude: the
+  // attitude the inner loop is designed to have reached by now. (The actual
+  // attitude would also pass on the inner loop's own tracking errors, which
+  // its adaptive element is there to remove, and the outer reference model
+  // would drift after the vehicle.)
+  const Vec3 accel_achievable =
+      (-thrust_achievable * ref_attitude_.toRotationMatrix().col(2) + other_world) / p.mass +
+      Vec3(0, 0, kGravity);
+  const Vec3 angular_achievable =
+      angular_accel_for(achievable, thrust_achievable, air_body, w, loads.rotor_torque);
+  if (g.hedging) {
+    out.hedge_accel = accel_wanted - accel_achievable;
+    out.hedge_angular = angular - angular_achievable;
+  }
+
+  adaptive_->update(ad);
+
+  // Reference models advance by what the vehicle can follow.
+  const Vec3 rm_accel_hedged = rm_accel - out.hedge_accel;
+  ref_position_ += dt * (ref_velocity_ + 0.5 * dt * rm_accel_hedged);
+  ref_velocity_ += dt * rm_accel_hedged;
+  ref_rates_ += dt * (rm_angular - out.hedge_angular);
+  const Vec3 turn = ref_rates_ * dt;
+  if (turn.norm() > 0)
+    ref_attitude_ =
+        (ref_attitude_ * Quat(Eigen::AngleAxisd(turn.norm(), turn.normalized()))).normalized();
+  out.reference_position = ref_position_;
+  actuator_estimate_ = achievable;
+
+  const bool states_finite = ref_position_.allFinite() && ref_velocity_.allFinite() &&
+                             ref_rates_.allFinite() && ref_attitude_.coeffs().allFinite() &&
+                             position_integral_.allFinite() && attitude_integral_.allFinite();
+  if (!finite(out.controls) || !out.commanded_accel.allFinite() || !states_finite) {
+    out = ControlOutput{};
     out.controls = hover_;
-    out.commanded_accel.setZero();
     out.valid = false;
     reset();
   }

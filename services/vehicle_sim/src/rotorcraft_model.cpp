@@ -129,9 +129,9 @@ RotorcraftDerivative RotorcraftModel::derivative(const RotorcraftState& s, const
   // Servos: first-order lag toward the (clamped) command, rate limited.
   const auto target = clamp_controls(command, p).as_array();
   const auto now = act.as_array();
+  const auto rate = p.actuator_rate.as_array();
   for (int i = 0; i < 4; ++i)
-    d.actuator_dot[i] =
-        std::clamp((target[i] - now[i]) / p.servo_time_constant, -p.actuator_rate, p.actuator_rate);
+    d.actuator_dot[i] = std::clamp((target[i] - now[i]) / p.servo_time_constant, -rate[i], rate[i]);
   if (loads_out) *loads_out = loads;
   return d;
 }

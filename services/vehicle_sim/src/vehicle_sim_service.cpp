@@ -78,7 +78,8 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
       airframe.number_in("inflow_time_constant", p.inflow_time_constant, 0.01, 2.0);
   p.servo_time_constant =
       airframe.number_in("servo_time_constant", p.servo_time_constant, 0.001, 1.0);
-  p.actuator_rate = airframe.number_in("actuator_rate", p.actuator_rate, 0.01, 100.0);
+  const double rate = airframe.number_in("actuator_rate", p.actuator_rate.collective, 0.01, 100.0);
+  p.actuator_rate = {rate, rate, rate, rate};
   airframe.finish();
   YamlReader lidar = r.child("lidar");
   c.lidar = load_lidar_config(lidar);
@@ -92,20 +93,32 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
     : node_("vehicle_sim", lcm, clock),
       config_(std::move(config)),
       real_time_factor_(real_time_factor),
-      model_(config_.params),
+      vehicle_(apply_variation(config_.params, scenario.vehicle), scenario.wind,
+               scenario.disturbances, scenario.ground_altitude),
       world_({}, scenario.ground_altitude),
       lidar_(config_.lidar, scenario.limits.sensor_range) {
-  model_.set_wind(scenario.wind);
-  const TrimResult t = trim(model_, scenario.start_velocity, scenario.start_heading, scenario.wind);
+  const TrimResult t =
+      trim(vehicle_.model(), scenario.start_velocity, scenario.start_heading, scenario.wind);
   if (!t.converged)
     throw std::runtime_error("no trim for the start state of " + scenario.file +
                              " (speed beyond the airframe's envelope?)");
   start_state_ = t.state;
   start_state_.position = scenario.start_position;
   trim_controls_ = t.controls;
-  model_.set_state(start_state_);
-  model_.set_command(trim_controls_);
+  vehicle_.reset(start_state_, 0.0);
+  vehicle_.set_command(trim_controls_);
   released_ = !config_.hold_until_engaged;
+  const auto& v = scenario.vehicle;
+  const auto& d = scenario.disturbances;
+  if (v.mass_scale != 1.0 || v.inertia_scale != Vec3::Ones() || v.actuator_time_scale != 1.0)
+    node_.log().info(
+        "airframe varied: mass x{:.2f}, inertia x[{:.2f} {:.2f} {:.2f}], "
+        "time constants x{:.2f}",
+        v.mass_scale, v.inertia_scale.x(), v.inertia_scale.y(), v.inertia_scale.z(),
+        v.actuator_time_scale);
+  if (d.turbulence.active())
+    node_.log().info("Dryden turbulence on (seed {}), W20 {:.1f} m/s", d.seed,
+                     d.turbulence.wind_at_20ft);
   node_.log().info(
       "start trim: collective {:.3f} lon {:.3f} lat {:.3f} pedal {:.3f} rad, "
       "pitch {:.2f} roll {:.2f} deg",
@@ -137,7 +150,7 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
 void VehicleSimService::on_command(const actuator_cmd_t& m) {
   last_command_time_ = node_.now();
   // Until released the vehicle flies its trim, whatever the controller says.
-  if (released_) model_.set_command({m.collective, m.lon_cyclic, m.lat_cyclic, m.pedal});
+  if (released_) vehicle_.set_command({m.collective, m.lon_cyclic, m.lat_cyclic, m.pedal});
 }
 
 void VehicleSimService::on_control_status(const control_status_t& m) {
@@ -188,6 +201,7 @@ void VehicleSimService::step_physics() {
   if (state_time_ == INT64_MIN) {
     state_time_ = now;
     hold_started_ = now;
+    vehicle_.reset(start_state_, to_seconds(now));
   }
   if (!released_ && now - hold_started_ >= to_utime(config_.engage_timeout)) {
     released_ = true;
@@ -198,15 +212,15 @@ void VehicleSimService::step_physics() {
   // stamped with the time it is valid for.
   while (state_time_ + dt_us <= now) {
     if (released_) {
-      model_.step(to_seconds(dt_us));
+      vehicle_.step(to_seconds(dt_us));
     } else {
       // Held: trimmed flight frozen at the start point.
-      model_.set_state(start_state_);
+      vehicle_.hold(start_state_, to_seconds(dt_us));
     }
     state_time_ += dt_us;
     ++steps_;
     if (config_.lidar.enabled) {
-      const RotorcraftState& s = model_.state();
+      const RotorcraftState& s = vehicle_.model().state();
       lidar_.advance(state_time_, s.position, s.attitude, world_);
       while (auto scan = lidar_.take_completed_scan()) publish_scan(*scan);
     }
@@ -218,12 +232,14 @@ void VehicleSimService::step_physics() {
 
 void VehicleSimService::publish_nav() {
   if (state_time_ == INT64_MIN) return;
-  const RotorcraftState& s = model_.state();
+  // The navigation solution is stamped with the time it is valid for: with
+  // latency, that is older than the state.
+  const NavSample s = vehicle_.measure();
   nav_state_t nav;
-  nav.utime = state_time_;
+  nav.utime = state_time_ - to_utime(vehicle_.time() - s.time);
   nav.frame = "NED";
   const Vec3 euler = euler_from_quat(s.attitude);
-  const Vec3 accel = released_ ? model_.acceleration() : Vec3::Zero();
+  const Vec3 accel = released_ ? s.acceleration : Vec3::Zero();
   for (int i = 0; i < 3; ++i) {
     nav.position[i] = s.position[i];
     nav.velocity[i] = s.velocity[i];

@@ -3,6 +3,7 @@
 // waypoints, limits, timing gates and environment. Everything is converted
 // to SI and world NED on load. See docs/SCENARIO_FORMAT.md.
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,45 @@ struct Waypoint {
   double capture_radius = 0;     // m
 };
 
+/// The airframe as flown, relative to the model the controller assumes
+/// (vehicle_sim's configured airframe), and its actuator authority. The
+/// defaults leave the airframe as configured.
+struct VehicleVariation {
+  double mass_scale = 1.0;
+  Vec3 inertia_scale = Vec3::Ones();  // roll, pitch, yaw
+  double actuator_time_scale = 1.0;   // servo lag and rotor flapping time constants
+  // Actuator authority; unset: the airframe's own. rad and rad/s.
+  std::optional<double> collective_min, collective_max;
+  std::optional<double> cyclic_limit, pedal_limit;  // symmetric, +-
+  std::optional<double> collective_rate, cyclic_rate, pedal_rate;
+};
+
+/// Dryden turbulence (MIL-F-8785C, low-altitude form). Intensity either from
+/// the wind speed at 20 ft (light 15 kt, moderate 30 kt, severe 45 kt) or
+/// explicit; scale lengths from the altitude unless explicit.
+struct TurbulenceSpec {
+  double wind_at_20ft = 0;           // m/s; 0 and no explicit sigma: no turbulence
+  std::optional<Vec3> sigma;         // m/s along the flight path (u), across it (v), down (w)
+  std::optional<Vec3> scale_length;  // m, L_u, L_v, L_w
+  bool active() const { return wind_at_20ft > 0 || (sigma && sigma->norm() > 0); }
+};
+
+/// Errors of the navigation solution: white noise on what NAV_STATE reports
+/// and its age when it is published.
+struct NavErrorSpec {
+  double position_sigma = 0;  // m, per axis
+  double velocity_sigma = 0;  // m/s, per axis
+  double attitude_sigma = 0;  // rad, per axis (small rotation)
+  double rate_sigma = 0;      // rad/s, per axis
+  double latency = 0;         // s
+};
+
+struct Disturbances {
+  TurbulenceSpec turbulence;
+  NavErrorSpec nav;
+  uint32_t seed = 1;  // turbulence and nav-noise random stream
+};
+
 struct Scenario {
   std::string name;
   std::string description;
@@ -72,6 +112,9 @@ struct Scenario {
 
   Vec3 wind = Vec3::Zero();  // m/s, world NED, velocity of the air mass
   double max_time = 600;     // s of simulated time before a run is abandoned
+
+  VehicleVariation vehicle;   // `vehicle:` section
+  Disturbances disturbances;  // `disturbances:` section
 };
 
 /// Loads and checks a scenario; throws ConfigError naming the file and field.

@@ -8,6 +8,7 @@
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/controller/neural_adaptation.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
 #include "ofn/lidar_scan_t.hpp"
@@ -33,6 +34,7 @@ struct ControllerConfig {
   double nav_timeout = 0.2;       // s; older navigation counts as lost
   double ref_traj_timeout = 0.5;  // s; an older REF_TRAJ is no longer followed
   ControllerGains gains;
+  AdaptiveConfig adaptive;
   GuidanceConfig guidance;
   YawSweep sweep;
   vehicle::RotorcraftParams nominal;  // the controller's model of the airframe
@@ -54,7 +56,14 @@ class ControllerService {
  private:
   void on_nav(const nav_state_t& m) { nav_ = m; }
   void on_mission(const mission_t& m);
-  void on_ref_traj(const ref_traj_t& m) { ref_traj_ = m; }
+  // A NOMINAL trajectory is advice only: waypoint guidance keeps flying.
+  // Avoidance, a kept previous plan and braking override it (paper 2.1).
+  void on_ref_traj(const ref_traj_t& m) {
+    if (m.mode == ref_traj_t::NOMINAL)
+      ref_traj_.reset();
+    else
+      ref_traj_ = m;
+  }
   void on_lidar_scan();
   void control_step();
   void publish_status();

@@ -1,13 +1,20 @@
 #pragma once
 // Trajectory follower by approximate model inversion (after Johnson and
 // Kannan's adaptive trajectory controller, paper Fig. 2):
-//   outer loop: position/velocity errors -> acceleration pseudo-control
-//               (reference feed-forward + PID - adaptive share) -> inverted to
-//               a thrust vector, i.e. collective and a desired attitude;
-//   inner loop: attitude/rate errors -> angular-acceleration pseudo-control
-//               -> inverted through the nominal rotor model to cyclic and pedal.
-// The adaptive element plugs in through AdaptiveElement; the default one
-// adds nothing. Pure core: no LCM, no clock (dt is passed in).
+//   outer loop: a reference model driven by the commanded trajectory;
+//               errors to it -> acceleration pseudo-control (reference-model
+//               acceleration + PID - adaptive share) -> inverted to a thrust
+//               vector, i.e. collective and a desired attitude;
+//   inner loop: a reference model driven by that attitude; errors to it ->
+//               angular-acceleration pseudo-control -> inverted through the
+//               nominal rotor model to cyclic and pedal.
+// Pseudo-control hedging: what the model says the vehicle cannot do (bounds,
+// actuator limits and rates, and for the outer loop the attitude not yet
+// reached) is taken out of each reference model's acceleration, so neither
+// the adaptive element nor the integrators learn from it.
+// The adaptive element plugs in through AdaptiveElement (NeuralAdaptation
+// in neural_adaptation.hpp); the default one adds nothing. Pure core: no
+// LCM, no clock (dt is passed in).
 
 #include <memory>
 
@@ -38,22 +45,38 @@ struct ControllerGains {
   Vec3 integral = Vec3(0.04, 0.04, 0.1);  // 1/s^3
   double integral_limit = 1.0;            // m/s^2, largest integral share
   double integral_band = 1.0;             // m, integrate only errors smaller than this
-  double max_horizontal_accel = 3.0;      // m/s^2, pseudo-control bound
-  double max_vertical_accel = 3.0;        // m/s^2
-  double max_tilt = deg2rad(25.0);        // rad
+  // Authority for gusts and a 15 kt crosswind on a heavier airframe.
+  double max_horizontal_accel = 5.0;  // m/s^2, pseudo-control bound
+  double max_vertical_accel = 3.0;    // m/s^2
+  double max_tilt = deg2rad(35.0);    // rad
   // Inner loop per body axis (roll, pitch, yaw).
   Vec3 attitude = Vec3(9.0, 9.0, 4.0);           // 1/s^2
   Vec3 rate = Vec3(4.8, 4.8, 4.0);               // 1/s
   Vec3 attitude_integral = Vec3(2.0, 2.0, 1.0);  // 1/s^3
   double attitude_integral_limit = 2.0;          // rad/s^2
+  // Reference models: second order, natural frequency and damping per loop.
+  double outer_reference_frequency = 1.0;  // rad/s
+  double outer_reference_damping = 1.0;
+  double inner_reference_frequency = 5.0;  // rad/s
+  double inner_reference_damping = 1.0;
+  // Pseudo-control hedging: off only to show what it prevents.
+  bool hedging = true;
 };
 
 /// Inputs an adaptive element sees each step.
 struct AdaptiveInputs {
-  Vec3 position_error, velocity_error;  // reference - actual, world
-  Vec3 attitude_error, rate_error;      // body
+  Vec3 position_error, velocity_error;  // reference model - actual, world
+  Vec3 attitude_error, rate_error;      // reference model - actual, body
   Vec3 pseudo_accel, pseudo_angular;    // pseudo-controls before the adaptive share
   Vec3 velocity, body_rates;
+  Vec3 body_velocity;  // velocity in body axes
+  Vec3 gravity_body;   // unit down vector in body axes (the attitude)
+  Vec3 nose_world;     // body x axis in world axes (the heading: a steady wind
+                       // loads the airframe differently on every heading)
+  // e^T P B of each loop's linear error dynamics (P from the loop gains), and
+  // the error norms, for the update law.
+  Vec3 outer_error_signal, inner_error_signal;
+  double outer_error_norm = 0, inner_error_norm = 0;
   double dt = 0;
 };
 
@@ -67,6 +90,8 @@ class AdaptiveElement {
   virtual Vec3 inner_output(const AdaptiveInputs& in) = 0;
   virtual void update(const AdaptiveInputs& in) = 0;
   virtual void reset() = 0;
+  /// Size of the adapted weights (0 when nothing adapts), to watch for drift.
+  virtual double weight_norm() const { return 0.0; }
 };
 
 /// Adds nothing: the non-adaptive baseline.
@@ -80,8 +105,12 @@ class NoAdaptation final : public AdaptiveElement {
 
 struct ControlOutput {
   vehicle::Controls controls;
-  Vec3 commanded_accel = Vec3::Zero();  // outer-loop pseudo-control, world NED
-  Vec3 adaptive_accel = Vec3::Zero();   // adaptive share of it
+  Vec3 commanded_accel = Vec3::Zero();     // outer-loop pseudo-control, world NED
+  Vec3 adaptive_accel = Vec3::Zero();      // adaptive share of it
+  Vec3 adaptive_angular = Vec3::Zero();    // inner-loop adaptive share, rad/s^2
+  Vec3 hedge_accel = Vec3::Zero();         // outer hedge: commanded - achievable, m/s^2
+  Vec3 hedge_angular = Vec3::Zero();       // inner hedge, rad/s^2
+  Vec3 reference_position = Vec3::Zero();  // outer reference model, world NED
   Quat attitude_command = Quat::Identity();
   double thrust = 0;       // N
   bool saturated = false;  // an actuator or pseudo-control bound was hit
@@ -101,9 +130,14 @@ class TrajectoryController {
   vehicle::Controls hover_command() const { return hover_; }
   const ControllerGains& gains() const { return gains_; }
   const vehicle::RotorcraftModel& nominal_model() const { return model_; }
+  const AdaptiveElement& adaptive() const { return *adaptive_; }
 
  private:
   double collective_for_thrust(double thrust, const Vec3& air_body) const;
+  /// Angular acceleration the nominal model gives for controls (the
+  /// inverse of the inner loop's inversion).
+  Vec3 angular_accel_for(const vehicle::Controls& c, double thrust, const Vec3& air_body,
+                         const Vec3& body_rates, double rotor_torque) const;
 
   vehicle::RotorcraftModel model_;
   ControllerGains gains_;
@@ -113,6 +147,16 @@ class TrajectoryController {
   Vec3 attitude_integral_ = Vec3::Zero();
   double tail_thrust_estimate_ = 0;  // N, side force of the tail rotor
   double hover_tail_thrust_ = 0;     // N, its hover value, after a reset
+  // Reference models; started at the vehicle's state on the first step
+  // after a reset.
+  bool reference_started_ = false;
+  Vec3 ref_position_ = Vec3::Zero(), ref_velocity_ = Vec3::Zero();
+  Quat ref_attitude_ = Quat::Identity();
+  Vec3 ref_rates_ = Vec3::Zero();
+  // Actuator positions the nominal servos can have reached (rate limits).
+  vehicle::Controls actuator_estimate_;
+  // Error-dynamics weights e^T P B per axis: position/attitude and rate terms.
+  Vec3 outer_p12_, outer_p22_, inner_p12_, inner_p22_;
 };
 
 }  // namespace ofn::control

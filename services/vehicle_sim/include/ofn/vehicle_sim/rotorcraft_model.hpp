@@ -63,8 +63,8 @@ struct RotorcraftParams {
   // Actuators: limits, rates and servo lag
   Controls min_controls{-0.05, -0.16, -0.16, -0.40};
   Controls max_controls{0.30, 0.16, 0.16, 0.40};
-  double actuator_rate = 1.5;         // rad/s, every channel
-  double servo_time_constant = 0.04;  // s
+  Controls actuator_rate{1.5, 1.5, 1.5, 1.5};  // rad/s, per channel
+  double servo_time_constant = 0.04;           // s
 
   double disk_area() const { return kPi * rotor_radius * rotor_radius; }
   double tip_speed() const { return rotor_speed * rotor_radius; }

@@ -2,12 +2,15 @@
 // Binds the rotorcraft model and the LIDAR head to the bus: ACTUATOR_CMD,
 // CONTROL_STATUS and VIRTUAL_OBSTACLES in; NAV_STATE, SIM_CLOCK and LIDAR_RAW
 // out. Physics and the scanner run on a fixed-step timer of the node's clock.
+// The scenario sets the airframe's deviation from the configured one, the
+// wind and turbulence, and the navigation solution's noise and latency.
 
 #include <string>
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/vehicle_sim/disturbances.hpp"
 #include "ofn/vehicle_sim/lidar_head.hpp"
 #include "ofn/vehicle_sim/rotorcraft_model.hpp"
 #include "ofn/virtual_obstacles_t.hpp"
@@ -38,7 +41,8 @@ class VehicleSimService {
                     VehicleSimConfig config, double real_time_factor = 1.0);
 
   Node& node() { return node_; }
-  const RotorcraftModel& model() const { return model_; }
+  const RotorcraftModel& model() const { return vehicle_.model(); }
+  const SimulatedVehicle& vehicle() const { return vehicle_; }
   bool released() const { return released_; }
   const world::World& world() const { return world_; }
   const LidarHead& lidar() const { return lidar_; }
@@ -55,7 +59,7 @@ class VehicleSimService {
   Node node_;
   VehicleSimConfig config_;
   double real_time_factor_;
-  RotorcraftModel model_;
+  SimulatedVehicle vehicle_;
   RotorcraftState start_state_;
   Controls trim_controls_;
   Utime state_time_ = INT64_MIN;

@@ -1,0 +1,54 @@
+#pragma once
+// A course flown in-process: the simulated vehicle (airframe variation,
+// wind, turbulence, navigation errors from the scenario) and the trajectory
+// follower stepped together under waypoint guidance, with no bus. Measures
+// how well the vehicle follows the commanded trajectory; used by the
+// adaptive-control tests, benchmarks and the tracking sweep.
+
+#include <vector>
+
+#include "ofn/common/scenario.hpp"
+#include "ofn/controller/neural_adaptation.hpp"
+#include "ofn/controller/trajectory_controller.hpp"
+#include "ofn/controller/waypoint_guidance.hpp"
+#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+
+namespace ofn::control {
+
+struct TrackingFlightConfig {
+  double duration = 600;      // s of flight
+  double control_rate = 100;  // Hz
+  double physics_rate = 400;  // Hz
+  bool round_trip = true;     // at the last waypoint, fly the route back, until `duration`
+  bool yaw_sweep = true;      // the scanner's yaw sweep (0.2 Hz, 40 deg peak to peak)
+  double settle_time = 5;     // s at the start left out of the error statistics
+  double trace_interval = 1;  // s between samples of the traces
+};
+
+struct TrackingResult {
+  double rms_error = 0;  // m, commanded position - true position
+  double max_error = 0;  // m
+  double rms_error_first_half = 0, rms_error_second_half = 0;
+  double max_weight_norm = 0, final_weight_norm = 0;
+  bool all_valid = true;          // no step fell back to the safe command
+  bool all_within_limits = true;  // every command within the nominal actuator limits
+  bool finite = true;             // the vehicle's state stayed finite
+  int legs_flown = 0;
+  std::vector<double> weight_norm_trace;  // every trace_interval
+  std::vector<double> error_trace;        // m, every trace_interval
+};
+
+struct TrackingSetup {
+  vehicle::RotorcraftParams nominal;  // the controller's model; the flown airframe is this
+                                      // changed by the scenario's `vehicle:` section
+  ControllerGains gains;
+  AdaptiveConfig adaptive;
+  GuidanceConfig guidance;
+};
+
+/// Flies the scenario's waypoints (steady wind, disturbances, airframe
+/// variation all from the scenario).
+TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup,
+                            const TrackingFlightConfig& config = {});
+
+}  // namespace ofn::control
