@@ -12,7 +12,8 @@ PYTHON   := /usr/bin/python3
 DEBIAN_PACKAGES := cmake make g++ git liblcm-dev liblcm-bin liblcm-java libjchart2d-java \
   default-jdk-headless libeigen3-dev libnlopt-cxx-dev libnlopt-dev liboctomap-dev \
   libdynamicedt3d-dev libspdlog-dev libcli11-dev libyaml-cpp-dev libgtest-dev \
-  libbenchmark-dev python3 python3-matplotlib python3-numpy python3-yaml iproute2 \
+  libbenchmark-dev libompl-dev libboost-serialization-dev libboost-filesystem-dev \
+  libboost-system-dev python3 python3-matplotlib python3-numpy python3-yaml iproute2 \
   util-linux procps
 
 .PHONY: all deps build run test bench spy clean format

@@ -1,0 +1,212 @@
+// The global planner on the bus: a route from MISSION, NAV_STATE and CUBOIDS,
+// republished once a second and at once when the cuboids change; bad input
+// is rejected and counted, and the service keeps running.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "ofn/common/channels.hpp"
+#include "ofn/common/clock.hpp"
+#include "ofn/common/logging.hpp"
+#include "ofn/common/node.hpp"
+#include "ofn/global_planner/global_planner_service.hpp"
+
+namespace ofn::planning {
+namespace {
+
+constexpr Utime kStart = 10 * kMicrosPerSecond;
+constexpr double kAltitude = 36.6;  // m, 120 ft
+
+mission_t mission() {
+  mission_t m{};
+  m.utime = kStart;
+  m.mission_id = 1;
+  m.name = "wall";
+  m.frame = "NED";
+  m.cruise_speed = 3.048;
+  m.limits.max_speed = 3.048;
+  m.limits.max_accel = 0.48768;
+  m.limits.max_vertical_speed = 1.524;
+  m.limits.min_forward_speed = 0;
+  m.limits.clearance = 6.096;
+  m.limits.sensor_range = 60.96;
+  for (double north : {-30.48, 152.4}) {
+    waypoint_t w{};
+    w.position[0] = north;
+    w.position[2] = -kAltitude;
+    w.capture_radius = 3.0;
+    m.waypoints.push_back(w);
+  }
+  m.num_waypoints = 2;
+  return m;
+}
+
+nav_state_t nav(Utime t, double north) {
+  nav_state_t m{};
+  m.utime = t;
+  m.frame = "NED";
+  m.position[0] = north;
+  m.position[2] = -kAltitude;
+  m.velocity[0] = 3.048;
+  m.quaternion[0] = 1;
+  return m;
+}
+
+/// bench1's wall: 10 ft thick, 300 ft wide, 140 ft tall, at 200 ft.
+cuboid_list_t wall(Utime t, bool top_observed = true) {
+  cuboid_list_t m{};
+  m.utime = t;
+  m.frame = "NED";
+  cuboid_t c{};
+  c.id = 7;
+  c.min_corner[0] = 59.4;
+  c.max_corner[0] = 62.5;
+  c.min_corner[1] = -45.7;
+  c.max_corner[1] = 45.7;
+  c.min_corner[2] = -42.7;
+  c.max_corner[2] = 0.0;
+  c.top_observed = top_observed;
+  c.confidence = 1;
+  c.last_seen_utime = t;
+  m.cuboids.push_back(c);
+  m.num_cuboids = 1;
+  return m;
+}
+
+class GlobalPlannerServiceTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { set_log_level("error"); }
+  static void TearDownTestSuite() { set_log_level("info"); }
+
+  GlobalPlannerServiceTest()
+      : lcm_("memq://"), clock_(kStart), service_(lcm_, clock_, config()), bus_("bus", lcm_, clock_) {
+    bus_.subscribe<global_path_t>(channels::kGlobalPath,
+                                  [this](const global_path_t& m) { paths_.push_back(m); });
+  }
+  static GlobalPlannerServiceConfig config() {
+    auto reader = YamlReader::empty("(defaults)");
+    return load_global_planner_config(reader);
+  }
+  void deliver() {
+    while (lcm_.handleTimeout(0) > 0) {
+    }
+  }
+  void advance_to(Utime t) {
+    while (true) {
+      // Timers are scheduled by their first firing.
+      const Utime next = service_.node().next_deadline();
+      if (next == INT64_MIN) {
+        service_.node().fire_due_timers(clock_.now());
+      } else if (next <= t) {
+        clock_.set(std::max(clock_.now(), next));
+        service_.node().fire_due_timers(clock_.now());
+      } else {
+        break;
+      }
+      deliver();
+    }
+    clock_.set(t);
+    deliver();
+  }
+  template <class Msg>
+  void send(const std::string& channel, const Msg& m) {
+    lcm_.publish(channel, &m);
+    deliver();
+  }
+  static double highest_altitude(const global_path_t& p) {
+    double h = -std::numeric_limits<double>::infinity();
+    for (const auto& q : p.points) h = std::max(h, -q[2]);
+    return h;
+  }
+
+  lcm::LCM lcm_;
+  ManualClock clock_;
+  GlobalPlannerService service_;
+  Node bus_;
+  std::vector<global_path_t> paths_;
+};
+
+TEST_F(GlobalPlannerServiceTest, NoRouteUntilMissionNavAndCuboidsAreKnown) {
+  send(channels::kMission, mission());
+  send(channels::kNavState, nav(kStart, 0));
+  advance_to(kStart + 3 * kMicrosPerSecond);
+  EXPECT_TRUE(paths_.empty());
+  send(channels::kNavState, nav(clock_.now(), 0));
+  send(channels::kCuboids, wall(clock_.now()));
+  ASSERT_FALSE(paths_.empty());
+}
+
+TEST_F(GlobalPlannerServiceTest, GoesOverTheWallAndReplansOnChange) {
+  send(channels::kMission, mission());
+  send(channels::kNavState, nav(kStart, 0));
+  send(channels::kCuboids, wall(kStart));
+  ASSERT_EQ(paths_.size(), 1u);
+  const global_path_t& first = paths_.back();
+  EXPECT_EQ(first.status, global_path_t::OK);
+  EXPECT_GT(first.cost, 152.4);
+  // Over the 42.7 m wall with 6.1 m clearance.
+  EXPECT_GE(highest_altitude(first), 42.7 + 6.096 - 0.1);
+  EXPECT_NEAR(first.points.front()[0], 0.0, 1e-9);
+  EXPECT_NEAR(first.points.back()[0], 152.4, 1e-9);
+
+  // Periodic replanning once a second (the first timer tick comes at once).
+  const size_t before = paths_.size();
+  for (int i = 1; i <= 3; ++i) {
+    const Utime t = kStart + i * kMicrosPerSecond - 100000;
+    advance_to(t);
+    send(channels::kNavState, nav(t, 3.0 * i));
+    send(channels::kCuboids, wall(t));  // the same set: no extra plan
+    advance_to(t + 200000);
+  }
+  EXPECT_GE(paths_.size() - before, 3u);
+  EXPECT_LE(paths_.size() - before, 4u);
+  // A narrower obstacle whose top was never seen (it reaches the ceiling):
+  // the route goes round.
+  const Utime t = clock_.now();
+  const size_t published = paths_.size();
+  send(channels::kNavState, nav(t, 0.0));
+  cuboid_list_t tower = wall(t, false);
+  tower.cuboids[0].min_corner[1] = -10;
+  tower.cuboids[0].max_corner[1] = 10;
+  send(channels::kCuboids, tower);
+  ASSERT_EQ(paths_.size(), published + 1);
+  EXPECT_EQ(paths_.back().status, global_path_t::OK);
+  EXPECT_LT(highest_altitude(paths_.back()), kAltitude + 1.0);
+}
+
+TEST_F(GlobalPlannerServiceTest, StartInsideAnObstacleIsReportedNotFatal) {
+  send(channels::kMission, mission());
+  send(channels::kNavState, nav(kStart, 61.0));  // inside the wall
+  send(channels::kCuboids, wall(kStart));
+  ASSERT_FALSE(paths_.empty());
+  EXPECT_EQ(paths_.back().status, global_path_t::START_INSIDE_OBSTACLE);
+  EXPECT_EQ(paths_.back().num_points, 0);
+}
+
+TEST_F(GlobalPlannerServiceTest, BadCuboidsAreRejectedAndCounted) {
+  send(channels::kMission, mission());
+  send(channels::kNavState, nav(kStart, 0));
+  cuboid_list_t bad = wall(kStart);
+  bad.cuboids[0].min_corner[1] = std::numeric_limits<double>::quiet_NaN();
+  send(channels::kCuboids, bad);
+  cuboid_list_t inverted = wall(kStart);
+  std::swap(inverted.cuboids[0].min_corner[0], inverted.cuboids[0].max_corner[0]);
+  send(channels::kCuboids, inverted);
+  const std::vector<uint8_t> junk(37, 0xAB);
+  lcm_.publish(channels::kCuboids, junk.data(), static_cast<unsigned>(junk.size()));
+  deliver();
+  EXPECT_TRUE(paths_.empty());
+  EXPECT_GE(service_.node().counters().rejected, 3);
+  // Still alive: a good set plans.
+  send(channels::kCuboids, wall(kStart));
+  ASSERT_EQ(paths_.size(), 1u);
+  EXPECT_EQ(paths_.back().status, global_path_t::OK);
+}
+
+}  // namespace
+}  // namespace ofn::planning
