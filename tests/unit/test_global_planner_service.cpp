@@ -84,7 +84,10 @@ class GlobalPlannerServiceTest : public ::testing::Test {
   static void TearDownTestSuite() { set_log_level("info"); }
 
   GlobalPlannerServiceTest()
-      : lcm_("memq://"), clock_(kStart), service_(lcm_, clock_, config()), bus_("bus", lcm_, clock_) {
+      : lcm_("memq://"),
+        clock_(kStart),
+        service_(lcm_, clock_, config()),
+        bus_("bus", lcm_, clock_) {
     bus_.subscribe<global_path_t>(channels::kGlobalPath,
                                   [this](const global_path_t& m) { paths_.push_back(m); });
   }

@@ -9,7 +9,9 @@
 namespace ofn::planning {
 namespace {
 
-Vec3 vec(const double v[3]) { return Vec3(v[0], v[1], v[2]); }
+Vec3 vec(const double v[3]) {
+  return Vec3(v[0], v[1], v[2]);
+}
 
 int8_t status_code(PlanStatus s) {
   switch (s) {
@@ -93,11 +95,10 @@ global_path_t path_message(const PlanResult& result, Utime utime,
   m.utime = utime;
   m.frame = "NED";
   m.status = status_code(result.status);
-  const PlanResult& shown =
-      result.status == PlanStatus::kNoPath && geometric_route &&
-              geometric_route->status == PlanStatus::kOk
-          ? *geometric_route
-          : result;
+  const PlanResult& shown = result.status == PlanStatus::kNoPath && geometric_route &&
+                                    geometric_route->status == PlanStatus::kOk
+                                ? *geometric_route
+                                : result;
   m.cost = std::isfinite(shown.cost) ? shown.cost : -1.0;
   m.num_points = static_cast<int32_t>(shown.path.size());
   for (const auto& p : shown.path) m.points.push_back({p.x(), p.y(), p.z()});
@@ -147,8 +148,8 @@ void GlobalPlannerService::on_mission(const mission_t& m) {
   legs_.clear();
   active_leg_ = -1;
   node_.log().info("mission {} '{}': clearance {:.2f} m, accel {:.3f} m/s^2, speed {:.2f} m/s",
-                   m.mission_id, m.name, planner_->config().clearance,
-                   planner_->config().max_accel, planner_->config().speed);
+                   m.mission_id, m.name, planner_->config().clearance, planner_->config().max_accel,
+                   planner_->config().speed);
   replan("new mission");
 }
 

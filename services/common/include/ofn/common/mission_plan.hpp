@@ -51,8 +51,8 @@ class LegTracker {
     }
     double best = std::numeric_limits<double>::infinity();
     for (size_t i = 1; i < waypoints_.size(); ++i) {
-      const double d = distance_to_segment(position, waypoints_[i - 1].position,
-                                           waypoints_[i].position);
+      const double d =
+          distance_to_segment(position, waypoints_[i - 1].position, waypoints_[i].position);
       if (d <= best) {
         best = d;
         active_ = static_cast<int>(i);

@@ -28,10 +28,10 @@ struct ObstacleBox {
 };
 
 struct GlobalPlannerConfig {
-  double clearance = 6.096;            // m, R_s: nodes sit this far outside every face
-  double merge_distance = 3.0;         // m; nodes closer than this merge into one (step 3)
-  double speed = 3.048;                // m/s, V of the Eq. 10 acceleration check
-  double max_accel = 0.4877;           // m/s^2, limit of the Eq. 10 check
+  double clearance = 6.096;     // m, R_s: nodes sit this far outside every face
+  double merge_distance = 3.0;  // m; nodes closer than this merge into one (step 3)
+  double speed = 3.048;         // m/s, V of the Eq. 10 acceleration check
+  double max_accel = 0.4877;    // m/s^2, limit of the Eq. 10 check
   // Eq. 10 assumes every segment starts and ends aligned with the leg. On
   // every segment that makes routes through offset gaps (bench6) or a
   // descent to a near goal (tree) "too sharp" although the optimiser flies
@@ -40,12 +40,12 @@ struct GlobalPlannerConfig {
   // what the vehicle cannot reach from its present state; true checks all,
   // as the paper does.
   bool accel_check_all_segments = false;
-  double ground_altitude = 0.0;        // m; the ground is at world z = -ground_altitude
-  double min_altitude = 6.096;         // m above ground; no node lower
-  double max_altitude = 150.0;         // m above ground; no node higher
-  double path_spacing = 2.0;           // m between points of the interpolated path (step 8)
-  double collision_tolerance = 0.05;   // m a segment may graze a clearance box by
-  int max_obstacles = 500;             // more are ignored, nearest first kept
+  double ground_altitude = 0.0;       // m; the ground is at world z = -ground_altitude
+  double min_altitude = 6.096;        // m above ground; no node lower
+  double max_altitude = 150.0;        // m above ground; no node higher
+  double path_spacing = 2.0;          // m between points of the interpolated path (step 8)
+  double collision_tolerance = 0.05;  // m a segment may graze a clearance box by
+  int max_obstacles = 500;            // more are ignored, nearest first kept
 };
 
 enum class PlanStatus { kOk, kStartInside, kGoalInside, kNoPath };
@@ -56,7 +56,7 @@ struct PlanRequest {
   Vec3 start = Vec3::Zero();           // m, world NED: the vehicle now
   Vec3 start_velocity = Vec3::Zero();  // m/s; its direction is the first segment's initial slope
   Vec3 goal = Vec3::Zero();            // m, world NED: the target waypoint
-  Vec3 leg_from = Vec3::Zero();        // m: previous waypoint; the guidance x axis is leg_from -> goal
+  Vec3 leg_from = Vec3::Zero();  // m: previous waypoint; the guidance x axis is leg_from -> goal
   std::vector<ObstacleBox> obstacles;
 };
 
