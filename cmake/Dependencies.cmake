@@ -38,3 +38,9 @@ ofn_require(octomap_FOUND "OctoMap" liboctomap-dev)
 add_library(ofn::octomap INTERFACE IMPORTED)
 set_target_properties(ofn::octomap PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${OCTOMAP_INCLUDE_DIRS}"
                                               INTERFACE_LINK_LIBRARIES "${OCTOMAP_LIBRARIES}")
+
+# NLopt: SLSQP for the RH trajectory optimiser (nlopt.hpp is a header-only wrapper of the C library).
+find_package(NLopt QUIET CONFIG)
+ofn_require(NLopt_FOUND "NLopt" libnlopt-dev)
+find_file(NLOPT_CXX_HEADER nlopt.hpp)
+ofn_require(NLOPT_CXX_HEADER "NLopt C++ header" libnlopt-cxx-dev)

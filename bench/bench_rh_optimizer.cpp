@@ -1,0 +1,194 @@
+// Cost of one receding-horizon solve over a recorded-style flight: the
+// vehicle follows each solution kinematically for 0.1 s while approaching
+// and passing bench1's wall (over) and bench4's cube (around), against the
+// rasterised true obstacles. The same problems are then solved cold (from
+// the hand-made route), warm (from the recorded previous solution) and warm
+// with MMA instead of SLSQP. Counters: median and 99th-percentile solve
+// time (ms), mean objective evaluations, share of feasible solves.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ofn/common/scenario.hpp"
+#include "ofn/mapper/distance_field.hpp"
+#include "ofn/rh_optimizer/rh_optimizer.hpp"
+#include "ofn/world/world.hpp"
+
+namespace {
+
+using ofn::Vec3;
+using namespace ofn::rh;
+
+constexpr double kStep = 0.1;          // s the vehicle follows each solution
+constexpr double kMapperMargin = 1.5;  // m, horizontal inflation like the mapper's grid
+
+ofn::mapping::Heightfield rasterise(const ofn::Scenario& scenario) {
+  ofn::mapping::Heightfield field;
+  field.origin_north = -45;
+  field.origin_east = -85;
+  field.rows = 185;
+  field.cols = 170;
+  field.top.assign(static_cast<size_t>(field.rows) * field.cols, 0.0f);
+  for (const ofn::ObstacleSpec& spec : scenario.obstacles) {
+    const ofn::world::Obstacle obstacle(spec, scenario.ground_altitude);
+    for (int r = 0; r < field.rows; ++r)
+      for (int c = 0; c < field.cols; ++c) {
+        const Vec3 p(field.cell_centre_north(r), field.cell_centre_east(c),
+                     -(scenario.ground_altitude + 0.5 * spec.height));
+        if (obstacle.distance(p) <= kMapperMargin)
+          field.at(r, c) = std::max(field.at(r, c), static_cast<float>(spec.height));
+      }
+  }
+  return field;
+}
+
+struct RecordedProblem {
+  RhProblem problem;
+  std::vector<Vec3> route;     // world NED, the cold guess
+  BsplineTrajectory previous;  // the solution flown into this problem
+  double elapsed = 0;          // s since that solution's start
+};
+
+Vec3 feet(double x, double y, double h) {
+  return ofn::course_to_ned(Vec3(x, y, h) * ofn::kMetresPerFoot);
+}
+
+void record_course(const std::string& name, const std::vector<Vec3>& route_feet,
+                   std::vector<RecordedProblem>& out) {
+  const ofn::Scenario scenario =
+      ofn::load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/" + name + ".yaml");
+  auto field = std::make_shared<ofn::mapping::DistanceField>();
+  field->build(rasterise(scenario), 0.0, 80.0);
+  std::vector<Vec3> route;
+  for (const Vec3& p : route_feet) route.push_back(feet(p.x(), p.y(), p.z()));
+  double far_north = -1e9;
+  for (const ofn::ObstacleSpec& spec : scenario.obstacles)
+    far_north = std::max(far_north, ofn::world::Obstacle(spec).bounds_max().x());
+
+  RhProblem problem;
+  problem.frame = ofn::GuidanceFrame::from_leg(scenario.waypoints.front().position,
+                                               scenario.waypoints.back().position);
+  problem.target = scenario.waypoints.back().position;
+  problem.limits = scenario.limits;
+  problem.clearance = [field](const Vec3& ned) { return field->query(ned); };
+  problem.position = feet(0, 0, 120);
+  problem.velocity = Vec3(scenario.cruise_speed, 0, 0);
+  const double far_x = problem.frame.to_guidance(Vec3(far_north, 0, 0)).x();
+
+  RhOptimizer optimizer;
+  BsplineTrajectory flown;
+  double flown_elapsed = 0;
+  int failures = 0;
+  for (int step = 0; step < 600 && problem.position.x() < feet(300, 0, 0).x(); ++step) {
+    // Eq. 6: the horizon ends past the farthest obstacle, or at the sensor's
+    // range once the obstacles are (nearly) behind.
+    const double x0 = problem.frame.to_guidance(problem.position).x();
+    const double past_obstacles = far_x + scenario.limits.clearance;
+    problem.terminal_x = past_obstacles > x0 + 0.5 * scenario.limits.sensor_range
+                             ? std::min(x0 + scenario.limits.sensor_range, past_obstacles)
+                             : x0 + scenario.limits.sensor_range;
+    const InitialGuess guess =
+        flown.empty() ? RhOptimizer::guess_from_path(route, problem, scenario.cruise_speed)
+                      : RhOptimizer::guess_from_previous(flown, flown_elapsed, problem);
+    if (!flown.empty()) out.push_back({problem, route, flown, flown_elapsed});
+    SolveReport report = optimizer.solve(problem, guess);
+    if (!report.feasible && guess.warm)
+      report = optimizer.solve(problem,
+                               RhOptimizer::guess_from_path(route, problem, scenario.cruise_speed));
+    if (report.feasible) {
+      flown = report.trajectory;
+      flown_elapsed = 0;
+    } else {
+      ++failures;
+    }
+    if (flown.empty()) break;
+    flown_elapsed += kStep;
+    problem.position = flown.position(flown_elapsed);
+    problem.velocity = flown.velocity(flown_elapsed);
+    problem.acceleration = flown.acceleration(flown_elapsed);
+  }
+  if (failures > 0)
+    std::fprintf(stderr, "%s: %d of the recorded solves failed (the older solution was flown on)\n",
+                 name.c_str(), failures);
+}
+
+const std::vector<RecordedProblem>& recorded_flight() {
+  static const std::vector<RecordedProblem> problems = [] {
+    std::vector<RecordedProblem> all;
+    record_course("bench1",
+                  {{-100, 0, 120}, {20, 0, 120}, {150, 0, 180}, {260, 0, 180}, {500, 0, 120}}, all);
+    record_course("bench4",
+                  {{-100, 0, 120},
+                   {40, 0, 120},
+                   {150, 75, 120},
+                   {250, 75, 120},
+                   {360, 0, 120},
+                   {500, 0, 120}},
+                  all);
+    return all;
+  }();
+  return problems;
+}
+
+enum class Start { kCold, kWarm };
+
+// stride: solve every stride-th problem of the sequence (MMA is slow enough
+// that the whole sequence would dominate the run).
+void run_sequence(benchmark::State& state, Start start, RhAlgorithm algorithm, size_t stride = 1) {
+  const std::vector<RecordedProblem>& all = recorded_flight();
+  std::vector<RecordedProblem> problems;
+  for (size_t i = 0; i < all.size(); i += stride) problems.push_back(all[i]);
+  RhSettings settings;
+  settings.algorithm = algorithm;
+  RhOptimizer optimizer(settings);
+  std::vector<double> times;
+  long evaluations = 0, feasible = 0;
+  for (auto _ : state) {
+    for (const RecordedProblem& recorded : problems) {
+      const InitialGuess guess =
+          start == Start::kWarm ? RhOptimizer::guess_from_previous(
+                                      recorded.previous, recorded.elapsed, recorded.problem)
+                                : RhOptimizer::guess_from_path(recorded.route, recorded.problem,
+                                                               recorded.problem.limits.max_speed);
+      const auto begin = std::chrono::steady_clock::now();
+      const SolveReport report = optimizer.solve(recorded.problem, guess);
+      times.push_back(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
+      evaluations += report.iterations;
+      feasible += report.feasible ? 1 : 0;
+    }
+  }
+  std::sort(times.begin(), times.end());
+  const auto at = [&](double q) {
+    return times[std::min(times.size() - 1, static_cast<size_t>(q * (times.size() - 1) + 0.5))];
+  };
+  const double solves = static_cast<double>(times.size());
+  state.counters["problems"] = static_cast<double>(problems.size());
+  state.counters["median_ms"] = 1e3 * at(0.5);
+  state.counters["p99_ms"] = 1e3 * at(0.99);
+  state.counters["max_ms"] = 1e3 * times.back();
+  state.counters["mean_evaluations"] = static_cast<double>(evaluations) / solves;
+  state.counters["feasible_share"] = static_cast<double>(feasible) / solves;
+}
+
+void BM_RhSolveCold(benchmark::State& state) {
+  run_sequence(state, Start::kCold, RhAlgorithm::kSlsqp);
+}
+void BM_RhSolveWarm(benchmark::State& state) {
+  run_sequence(state, Start::kWarm, RhAlgorithm::kSlsqp);
+}
+void BM_RhSolveWarmMma(benchmark::State& state) {
+  run_sequence(state, Start::kWarm, RhAlgorithm::kMma, 4);
+}
+BENCHMARK(BM_RhSolveCold)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RhSolveWarm)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RhSolveWarmMma)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,111 @@
+#pragma once
+// Binds the RH optimiser to the bus (paper 2.2): NAV_STATE, MISSION,
+// OBSTACLE_GRID and GLOBAL_PATH in; REF_TRAJ and SOLVER_STATS out at a fixed
+// rate. It builds the distance field from the grid, decides when avoidance
+// overrides nominal waypoint guidance (AvoidanceSwitch), and while it does,
+// solves one receding-horizon step per tick and publishes the trajectory
+// the controller follows. Handing back, it publishes a NOMINAL trajectory
+// so the controller resumes waypoint guidance at once.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ofn/common/config.hpp"
+#include "ofn/common/mission_plan.hpp"
+#include "ofn/common/node.hpp"
+#include "ofn/global_path_t.hpp"
+#include "ofn/mapper/distance_field.hpp"
+#include "ofn/mapper/heightfield.hpp"
+#include "ofn/mission_t.hpp"
+#include "ofn/nav_state_t.hpp"
+#include "ofn/obstacle_grid_t.hpp"
+#include "ofn/ref_traj_t.hpp"
+#include "ofn/rh_optimizer/avoidance_switch.hpp"
+#include "ofn/rh_optimizer/rh_planner.hpp"
+#include "ofn/solver_stats_t.hpp"
+
+namespace ofn::rh {
+
+struct RhOptimizerServiceConfig {
+  double rate = 10.0;                  // Hz, one receding-horizon step per tick (paper: 5-20 Hz)
+  double nav_max_age = 0.5;            // s; older NAV_STATE is stale
+  double grid_max_age = 1.0;           // s; older OBSTACLE_GRID is stale: no avoidance decisions
+  double path_max_age = 5.0;           // s; an older GLOBAL_PATH is not used as a guess
+  double sample_period = 0.1;          // s between REF_TRAJ samples
+  double route_change_distance = 5.0;  // m a new global path must differ by to be a new route
+  double field_period = 0.2;           // s; the distance field is rebuilt at most this often
+  double field_altitude_band = 40.0;   // m of altitude above and below the vehicle in the field
+  bool planned_initial_acceleration = true;  // a(t0) from the last plan, not the nav solution
+  // Before a first avoidance trajectory exists, a failed solve brakes only
+  // if the conflict is within braking distance plus this; otherwise nominal
+  // guidance continues (DEFERRED) and the next tick tries again, typically
+  // with the global route that the new obstacle is about to produce.
+  double defer_margin = 10.0;  // m
+  mapping::DistanceFieldConfig field;
+  RhSettings optimizer;
+  FallbackSettings fallback;
+  SwitchSettings avoidance;
+};
+
+/// Reads an rh_optimizer config; unknown fields are errors.
+RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& reader);
+
+/// The grid as a heightfield, padded with free cells so that the distance
+/// field (which holds its boundary values beyond its edges) reads
+/// `pad_distance` or more away from the obstacles.
+mapping::Heightfield padded_heightfield(const obstacle_grid_t& grid, double pad_distance);
+
+/// REF_TRAJ of a trajectory: the spline and samples every `period` seconds.
+ref_traj_t trajectory_message(const BsplineTrajectory& trajectory, Utime t0, int8_t mode,
+                              double period, Utime utime);
+
+/// Largest distance from a point of `b` (over its first `horizon` metres
+/// from `from`) to the polyline `a`: how much two routes differ where it
+/// matters.
+double route_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const Vec3& from,
+                        double horizon);
+
+class RhOptimizerService {
+ public:
+  RhOptimizerService(lcm::LCM& lcm, const Clock& clock, RhOptimizerServiceConfig config);
+  Node& node() { return node_; }
+  bool engaged() const { return switch_.engaged(); }
+  int64_t steps() const { return steps_; }
+
+ private:
+  void on_nav(const nav_state_t& m) { nav_ = m; }
+  void on_mission(const mission_t& m);
+  void on_grid(const obstacle_grid_t& m);
+  void on_global_path(const global_path_t& m);
+  void tick();
+  bool refresh_field(Utime now, const Vec3& vehicle);
+  void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
+  void publish_stats(Utime now, int8_t status, const std::string& message,
+                     const SolveReport* report);
+
+  Node node_;
+  RhOptimizerServiceConfig config_;
+  RhPlanner planner_;
+  AvoidanceSwitch switch_;
+  LegTracker legs_;
+  int active_leg_ = -1;
+  std::optional<nav_state_t> nav_;
+  std::optional<mission_t> mission_;
+  std::optional<obstacle_grid_t> grid_;
+  bool grid_dirty_ = false;
+  mapping::Heightfield heightfield_;
+  mapping::DistanceField field_;
+  bool field_valid_ = false;
+  Utime field_built_ = INT64_MIN;
+  double field_altitude_ = 0;  // vehicle altitude the field's band is centred on
+  std::vector<Vec3> route_;    // global path in use as the cold-start guess
+  Utime route_utime_ = INT64_MIN;
+  bool route_changed_ = false;
+  BsplineTrajectory last_trajectory_;  // last published, for a(t0)
+  Utime last_trajectory_t0_ = 0;
+  int64_t steps_ = 0;
+  std::string last_note_;
+};
+
+}  // namespace ofn::rh

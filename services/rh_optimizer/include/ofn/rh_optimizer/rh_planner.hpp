@@ -1,0 +1,65 @@
+#pragma once
+// One receding-horizon step with its warm starts and fallbacks (paper 2.2):
+// warm start from the previous solution shifted to now, or from the global
+// path when the route changed or the previous solution failed; when a solve
+// fails, keep the previous trajectory if it is still safe against the
+// current map, otherwise brake to a hover. Pure core, time in seconds of the
+// caller's clock.
+
+#include <string>
+#include <vector>
+
+#include "ofn/rh_optimizer/rh_optimizer.hpp"
+
+namespace ofn::rh {
+
+struct FallbackSettings {
+  double start_inside_fraction = 0.5;   // a start closer than this share of R_s is not solved from
+  double keep_min_remaining = 2.0;      // s a kept trajectory must still run
+  double braking_accel_fraction = 0.8;  // of limits.max_accel used to brake
+  bool cold_retry = true;               // after a failed warm solve, try once from the path
+};
+
+enum class StepMode { kSolved, kKeptPrevious, kBraking };
+
+const char* to_string(StepMode mode);
+
+struct StepInput {
+  RhProblem problem;
+  double time = 0;                   // s, clock time of the problem's state
+  std::vector<Vec3> global_path;     // world NED; empty when there is none
+  bool global_path_changed = false;  // a new route since the last step
+};
+
+struct StepOutput {
+  StepMode mode = StepMode::kBraking;
+  BsplineTrajectory trajectory;  // world NED
+  double start_time = 0;         // s, clock time of the trajectory's t = 0
+  SolveReport report;            // the last solve of this step (iterations 0 if none ran)
+  int solves = 0;                // solves run this step (a cold retry makes 2)
+  std::string reason;            // why a fallback was taken
+};
+
+class RhPlanner {
+ public:
+  explicit RhPlanner(RhSettings settings = {}, FallbackSettings fallback = {});
+
+  StepOutput step(const StepInput& input);
+  /// Forgets the previous solution (after avoidance hands back).
+  void reset();
+  bool has_previous() const { return !previous_.empty(); }
+
+  /// The braking trajectory: from the state now to a hover along the
+  /// current velocity at braking_accel_fraction of the limit.
+  BsplineTrajectory braking_trajectory(const RhProblem& problem) const;
+
+  const RhOptimizer& optimizer() const { return optimizer_; }
+
+ private:
+  RhOptimizer optimizer_;
+  FallbackSettings fallback_;
+  BsplineTrajectory previous_;  // last feasible solution
+  double previous_start_ = 0;
+};
+
+}  // namespace ofn::rh

@@ -1,0 +1,27 @@
+// rh_optimizer (Onboard2): receding-horizon trajectory optimisation and the
+// switch from nominal waypoint guidance to avoidance.
+
+#include <CLI/CLI.hpp>
+
+#include "ofn/common/service_main.hpp"
+#include "ofn/rh_optimizer/rh_optimizer_service.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"ofn rh_optimizer: B-spline trajectory optimisation in sensor range (REF_TRAJ)"};
+  ofn::CommonOptions options;
+  ofn::add_common_options(app, options);
+  CLI11_PARSE(app, argc, argv);
+
+  return ofn::guarded_main("ofn_rh_optimizer", [&] {
+    auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")
+                                         : ofn::YamlReader::load_file(options.config);
+    auto config = ofn::rh::load_rh_optimizer_config(reader);
+    auto lcm = ofn::open_lcm(options);
+    auto clock = ofn::make_clock(options.clock);
+    ofn::rh::RhOptimizerService service(*lcm, *clock, config);
+    service.node().log().info("{:.0f} Hz, B-spline degree {} over {} intervals, clock {}",
+                              config.rate, config.optimizer.degree, config.optimizer.intervals,
+                              clock->describe());
+    return ofn::run_nodes(*lcm, *clock, {&service.node()});
+  });
+}

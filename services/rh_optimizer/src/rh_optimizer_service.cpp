@@ -1,0 +1,425 @@
+#include "ofn/rh_optimizer/rh_optimizer_service.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "ofn/common/channels.hpp"
+
+namespace ofn::rh {
+namespace {
+
+Vec3 vec(const double v[3]) {
+  return Vec3(v[0], v[1], v[2]);
+}
+
+Vec3 vec3_in(YamlReader& r, const std::string& key, const Vec3& fallback, double lo, double hi) {
+  const std::vector<double> v = r.numbers(key, {fallback.x(), fallback.y(), fallback.z()});
+  if (v.size() != 3) r.fail(key, "expected three numbers [x, y, z]");
+  for (double x : v)
+    if (!(x >= lo && x <= hi)) r.fail(key, "each value must be within the allowed range");
+  return Vec3(v[0], v[1], v[2]);
+}
+
+int8_t stats_status(StepMode mode) {
+  switch (mode) {
+    case StepMode::kSolved:
+      return solver_stats_t::SOLVED;
+    case StepMode::kKeptPrevious:
+      return solver_stats_t::KEPT_PREVIOUS;
+    case StepMode::kBraking:
+      break;
+  }
+  return solver_stats_t::BRAKING;
+}
+
+int8_t traj_mode(StepMode mode) {
+  switch (mode) {
+    case StepMode::kSolved:
+      return ref_traj_t::AVOIDANCE;
+    case StepMode::kKeptPrevious:
+      return ref_traj_t::PREVIOUS;
+    case StepMode::kBraking:
+      break;
+  }
+  return ref_traj_t::BRAKING;
+}
+
+double distance_to_polyline(const std::vector<Vec3>& line, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  if (line.size() == 1) return (line[0] - p).norm();
+  for (size_t i = 1; i < line.size(); ++i) {
+    const Vec3 ab = line[i] - line[i - 1];
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((p - line[i - 1]).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (line[i - 1] + t * ab - p).norm());
+  }
+  return best;
+}
+
+}  // namespace
+
+RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
+  RhOptimizerServiceConfig c;
+  c.rate = r.number_in("rate_hz", c.rate, 0.5, 100.0);
+  c.nav_max_age = r.number_in("nav_max_age", c.nav_max_age, 0.01, 10.0);
+  c.grid_max_age = r.number_in("grid_max_age", c.grid_max_age, 0.05, 60.0);
+  c.path_max_age = r.number_in("path_max_age", c.path_max_age, 0.1, 600.0);
+  c.sample_period = r.number_in("sample_period", c.sample_period, 0.01, 1.0);
+  c.route_change_distance =
+      r.number_in("route_change_distance", c.route_change_distance, 0.1, 1000.0);
+  c.field_period = r.number_in("field_period", c.field_period, 0.0, 10.0);
+  c.field_altitude_band = r.number_in("field_altitude_band", c.field_altitude_band, 5.0, 1000.0);
+  c.planned_initial_acceleration =
+      r.boolean("planned_initial_acceleration", c.planned_initial_acceleration);
+  c.defer_margin = r.number_in("defer_margin", c.defer_margin, 0.0, 1000.0);
+
+  YamlReader field = r.child("distance_field");
+  c.field.vertical_resolution =
+      field.number_in("vertical_resolution", c.field.vertical_resolution, 0.1, 10.0);
+  c.field.max_distance = field.number_in("max_distance", c.field.max_distance, 5.0, 500.0);
+  field.finish();
+
+  YamlReader o = r.child("optimizer");
+  RhSettings& s = c.optimizer;
+  s.degree = o.integer("degree", s.degree);
+  s.intervals = o.integer("intervals", s.intervals);
+  s.collocation_points = o.integer("collocation_points", s.collocation_points);
+  s.time_constants = vec3_in(o, "time_constants", s.time_constants, 0.01, 10.0);
+  s.weights = vec3_in(o, "weights", s.weights, 1e-3, 1e6);
+  s.zero_terminal_accel = o.boolean("zero_terminal_accel", s.zero_terminal_accel);
+  s.clearance_margin = o.number_in("clearance_margin", s.clearance_margin, 0.0, 100.0);
+  s.min_altitude = o.number_in("min_altitude", s.min_altitude, 0.0, 1e4);
+  s.ground_altitude = o.number_in("ground_altitude", s.ground_altitude, -1e4, 1e4);
+  s.min_duration = o.number_in("min_duration", s.min_duration, 0.1, 1000.0);
+  s.max_duration = o.number_in("max_duration", s.max_duration, 0.2, 1000.0);
+  if (s.max_duration <= s.min_duration) o.fail("max_duration", "must exceed min_duration");
+  s.max_iterations = o.integer("max_iterations", s.max_iterations);
+  s.max_solve_time = o.number_in("max_solve_time", s.max_solve_time, 0.001, 10.0);
+  s.feasibility_tolerance =
+      o.number_in("feasibility_tolerance", s.feasibility_tolerance, 1e-8, 0.5);
+  const std::string algorithm =
+      o.text("algorithm", s.algorithm == RhAlgorithm::kMma ? "mma" : "slsqp");
+  if (algorithm == "slsqp")
+    s.algorithm = RhAlgorithm::kSlsqp;
+  else if (algorithm == "mma")
+    s.algorithm = RhAlgorithm::kMma;
+  else
+    o.fail("algorithm", "expected slsqp or mma");
+  o.finish();
+
+  YamlReader f = r.child("fallback");
+  FallbackSettings& b = c.fallback;
+  b.start_inside_fraction = f.number_in("start_inside_fraction", b.start_inside_fraction, 0.0, 1.0);
+  b.keep_min_remaining = f.number_in("keep_min_remaining", b.keep_min_remaining, 0.0, 60.0);
+  b.braking_accel_fraction =
+      f.number_in("braking_accel_fraction", b.braking_accel_fraction, 0.05, 1.0);
+  b.cold_retry = f.boolean("cold_retry", b.cold_retry);
+  f.finish();
+
+  YamlReader a = r.child("avoidance");
+  SwitchSettings& w = c.avoidance;
+  w.engage_margin = a.number_in("engage_margin", w.engage_margin, 0.0, 100.0);
+  w.rejoin_distance = a.number_in("rejoin_distance", w.rejoin_distance, 0.0, 1000.0);
+  w.check_spacing = a.number_in("check_spacing", w.check_spacing, 0.1, 10.0);
+  w.handback_distance = a.number_in("handback_distance", w.handback_distance, 0.0, 100.0);
+  w.handback_hold = a.number_in("handback_hold", w.handback_hold, 0.0, 60.0);
+  a.finish();
+  r.finish();
+  return c;
+}
+
+mapping::Heightfield padded_heightfield(const obstacle_grid_t& grid, double pad_distance) {
+  const int pad = static_cast<int>(std::ceil(pad_distance / grid.resolution)) + 1;
+  mapping::Heightfield f;
+  f.resolution = grid.resolution;
+  f.rows = grid.rows + 2 * pad;
+  f.cols = grid.cols + 2 * pad;
+  f.origin_north = grid.origin[0] - pad * grid.resolution;
+  f.origin_east = grid.origin[1] - pad * grid.resolution;
+  f.top.assign(static_cast<size_t>(f.rows) * f.cols, 0.0f);
+  for (int r = 0; r < grid.rows; ++r)
+    for (int c = 0; c < grid.cols; ++c)
+      f.at(r + pad, c + pad) = grid.top_altitude[static_cast<size_t>(r) * grid.cols + c];
+  return f;
+}
+
+ref_traj_t trajectory_message(const BsplineTrajectory& trajectory, Utime t0, int8_t mode,
+                              double period, Utime utime) {
+  ref_traj_t m;
+  m.utime = utime;
+  m.t0_utime = t0;
+  m.frame = "NED";
+  m.mode = mode;
+  m.degree = trajectory.degree();
+  m.knots = trajectory.knot_times();
+  m.num_knots = static_cast<int32_t>(m.knots.size());
+  for (const auto& p : trajectory.control_points())
+    m.control_points.push_back({p.x(), p.y(), p.z()});
+  m.num_control_points = static_cast<int32_t>(m.control_points.size());
+  const double duration = trajectory.duration();
+  const int n = std::max(2, static_cast<int>(std::ceil(duration / period - 1e-9)) + 1);
+  for (int i = 0; i < n; ++i) {
+    const double t = std::min(duration, i * period);
+    if (!m.sample_time.empty() && !(t > m.sample_time.back())) break;
+    const Vec3 p = trajectory.position(t), v = trajectory.velocity(t),
+               a = trajectory.acceleration(t);
+    m.sample_time.push_back(t);
+    m.position.push_back({p.x(), p.y(), p.z()});
+    m.velocity.push_back({v.x(), v.y(), v.z()});
+    m.acceleration.push_back({a.x(), a.y(), a.z()});
+  }
+  m.num_samples = static_cast<int32_t>(m.sample_time.size());
+  return m;
+}
+
+double route_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const Vec3& from,
+                        double horizon) {
+  if (a.empty() || b.empty()) return std::numeric_limits<double>::infinity();
+  double worst = 0;
+  for (const auto& p : b) {
+    if ((p - from).norm() > horizon) continue;
+    worst = std::max(worst, distance_to_polyline(a, p));
+  }
+  return worst;
+}
+
+RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
+                                       RhOptimizerServiceConfig config)
+    : node_("rh_optimizer", lcm, clock),
+      config_(std::move(config)),
+      planner_(config_.optimizer, config_.fallback),
+      switch_(config_.avoidance),
+      field_(config_.field) {
+  node_.subscribe<nav_state_t>(
+      channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
+      SubscribeOptions{config_.nav_max_age, 0.5});
+  // A plan is not state: it stays valid however old its stamp is.
+  node_.subscribe<mission_t>(
+      channels::kMission, [this](const mission_t& m) { on_mission(m); },
+      SubscribeOptions{0.0, 0.0});
+  node_.subscribe<obstacle_grid_t>(
+      channels::kObstacleGrid, [this](const obstacle_grid_t& m) { on_grid(m); },
+      SubscribeOptions{config_.grid_max_age, 0.5});
+  node_.subscribe<global_path_t>(
+      channels::kGlobalPath, [this](const global_path_t& m) { on_global_path(m); },
+      SubscribeOptions{config_.path_max_age, 0.5});
+  node_.add_timer(
+      1.0 / config_.rate, [this] { tick(); }, "rh_step");
+  node_.set_state("waiting for mission, nav and grid");
+}
+
+void RhOptimizerService::on_mission(const mission_t& m) {
+  if (mission_ && mission_->mission_id == m.mission_id && mission_->name == m.name) return;
+  if (m.waypoints.empty()) {
+    node_.reject(channels::kMission, "no waypoints");
+    return;
+  }
+  mission_ = m;
+  legs_.clear();
+  active_leg_ = -1;
+  planner_.reset();
+  switch_.reset();
+  node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
+                   m.mission_id, m.name, m.limits.clearance, config_.optimizer.clearance_margin,
+                   m.limits.max_accel);
+}
+
+void RhOptimizerService::on_grid(const obstacle_grid_t& m) {
+  if (grid_ && m.utime <= grid_->utime) {
+    node_.reject(channels::kObstacleGrid, "grid not newer than the last one");
+    return;
+  }
+  grid_ = m;
+  grid_dirty_ = true;
+}
+
+void RhOptimizerService::on_global_path(const global_path_t& m) {
+  // NO_PATH may still carry the shortest collision-free route (too sharp to
+  // fly as it is): a good guess of which way round.
+  if ((m.status != global_path_t::OK && m.status != global_path_t::NO_PATH) || m.points.size() < 2)
+    return;
+  std::vector<Vec3> points;
+  points.reserve(m.points.size());
+  for (const auto& p : m.points) points.emplace_back(p[0], p[1], p[2]);
+  const Vec3 from = nav_ ? vec(nav_->position) : points.front();
+  const double horizon = mission_ ? mission_->limits.sensor_range : 60.0;
+  // The planner re-publishes every second; only a different way round is a
+  // new route (and a reason to drop the warm start).
+  if (route_.empty() ||
+      route_difference(route_, points, from, horizon) > config_.route_change_distance) {
+    route_changed_ = true;
+    if (!route_.empty()) node_.log().info("new global route ({} points)", points.size());
+  }
+  route_ = std::move(points);
+  route_utime_ = m.utime;
+}
+
+bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
+  if (!grid_) return false;
+  const double vehicle_altitude = -vehicle.z();
+  const bool band_moved =
+      std::abs(vehicle_altitude - field_altitude_) > 0.25 * config_.field_altitude_band;
+  const bool due = field_built_ == INT64_MIN ||
+                   now - field_built_ >= to_utime(config_.field_period) || band_moved;
+  if (field_valid_ && !(grid_dirty_ && due) && !band_moved) return true;
+  heightfield_ = padded_heightfield(*grid_, config_.field.max_distance);
+  const double ground = config_.optimizer.ground_altitude;
+  const double alt = vehicle_altitude - ground;
+  const double lo = std::max(0.0, alt - config_.field_altitude_band);
+  const double hi = std::max(lo + 1.0, alt + config_.field_altitude_band);
+  field_.build(heightfield_, lo, hi);
+  field_valid_ = true;
+  field_built_ = now;
+  field_altitude_ = vehicle_altitude;
+  grid_dirty_ = false;
+  return true;
+}
+
+void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& velocity,
+                                   const std::string& why) {
+  // Two samples of where the vehicle is: a NOMINAL trajectory tells the
+  // controller to drop the avoidance reference now.
+  ref_traj_t m;
+  m.utime = now;
+  m.t0_utime = now;
+  m.frame = "NED";
+  m.mode = ref_traj_t::NOMINAL;
+  m.degree = 0;
+  m.num_knots = 0;
+  m.num_control_points = 0;
+  m.sample_time = {0.0, config_.sample_period};
+  const Vec3 ahead = position + velocity * config_.sample_period;
+  m.position = {{position.x(), position.y(), position.z()}, {ahead.x(), ahead.y(), ahead.z()}};
+  m.velocity = {{velocity.x(), velocity.y(), velocity.z()},
+                {velocity.x(), velocity.y(), velocity.z()}};
+  m.acceleration = {{0, 0, 0}, {0, 0, 0}};
+  m.num_samples = 2;
+  node_.publish(channels::kRefTraj, m);
+  planner_.reset();
+  last_trajectory_ = BsplineTrajectory();
+  node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
+                   why);
+}
+
+void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::string& message,
+                                       const SolveReport* report) {
+  solver_stats_t s{};
+  s.utime = now;
+  s.status = status;
+  s.message = message;
+  if (report) {
+    s.iterations = report->iterations;
+    s.solve_time = report->solve_time;
+    s.max_constraint_violation = std::isfinite(report->max_violation) ? report->max_violation : 1e9;
+    s.cost = std::isfinite(report->cost) ? report->cost : 0.0;
+    s.warm_started = report->warm_started;
+  }
+  node_.publish(channels::kSolverStats, s);
+}
+
+void RhOptimizerService::tick() {
+  const Utime now = node_.now();
+  auto note = [&](const std::string& text) {
+    if (text != last_note_) node_.set_state(text);
+    last_note_ = text;
+  };
+  if (!mission_ || !nav_) return note("waiting for mission and nav");
+  if (now - nav_->utime > to_utime(config_.nav_max_age)) {
+    note("nav stale");
+    return publish_stats(now, solver_stats_t::NOT_RUN, "nav stale", nullptr);
+  }
+  const Vec3 position = vec(nav_->position);
+  const Vec3 velocity = vec(nav_->velocity);
+  if (!legs_.has_plan()) legs_.set_plan(waypoints_from(*mission_), position);
+  const auto active = legs_.update(position);
+  if (!active) return note("no leg");
+  if (active->index != active_leg_) {
+    // A new leg is a new guidance frame: the previous solution is no guess.
+    active_leg_ = active->index;
+    planner_.reset();
+    route_changed_ = true;
+  }
+  if (!grid_ || now - grid_->utime > to_utime(config_.grid_max_age)) {
+    // Blind: no decisions on a map that is not there. An engaged avoidance
+    // keeps its last trajectory until the controller times it out.
+    note("no fresh obstacle grid");
+    return publish_stats(now, solver_stats_t::NOT_RUN, "no fresh obstacle grid", nullptr);
+  }
+  refresh_field(now, position);
+
+  const Limits limits = limits_from(mission_->limits);
+  const Leg leg{active->from, active->to};
+  const ClearanceQuery clearance = [this](const Vec3& p) { return field_.query(p); };
+  const double required = limits.clearance + config_.avoidance.engage_margin;
+  const NominalCheck nominal = check_nominal_path(clearance, leg, position, limits.sensor_range,
+                                                  required, config_.avoidance);
+  const bool conflict = std::isfinite(nominal.conflict_distance);
+  const bool was_engaged = switch_.engaged();
+  const double t = to_seconds(now);
+  const bool engaged = switch_.update(t, conflict, cross_track_distance(leg, position));
+  if (!engaged) {
+    if (was_engaged) hand_back(now, position, velocity, "nominal path clear, back on the leg");
+    note("nominal guidance");
+    return publish_stats(now, solver_stats_t::NOT_RUN, "nominal guidance: path clear", nullptr);
+  }
+  if (!was_engaged)
+    node_.log().info(
+        "avoidance engages at t={:.2f} s: nominal path clearance {:.1f} m < {:.1f} m, {:.1f} m "
+        "ahead",
+        t, nominal.least_clearance, required, nominal.conflict_distance);
+
+  StepInput in;
+  RhProblem& p = in.problem;
+  p.frame = GuidanceFrame::from_leg(leg.from, leg.to);
+  p.position = position;
+  p.velocity = velocity;
+  p.acceleration = vec(nav_->acceleration);
+  if (config_.planned_initial_acceleration && !last_trajectory_.empty()) {
+    const double since = to_seconds(now - last_trajectory_t0_);
+    if (since >= 0 && since <= last_trajectory_.duration())
+      p.acceleration = last_trajectory_.acceleration(since);
+  }
+  p.target = leg.to;
+  const double x_target = p.frame.to_guidance(leg.to).x();
+  const double min_horizon = std::min(limits.sensor_range, 4.0 * limits.clearance);
+  p.terminal_x =
+      terminal_x(p.frame, heightfield_, position, limits.sensor_range,
+                 limits.clearance + config_.optimizer.clearance_margin, x_target, min_horizon);
+  p.limits = limits;
+  p.clearance = clearance;
+  in.time = t;
+  if (!route_.empty() && now - route_utime_ <= to_utime(config_.path_max_age))
+    in.global_path = route_;
+  in.global_path_changed = route_changed_;
+  route_changed_ = false;
+
+  const bool had_trajectory = planner_.has_previous();
+  const StepOutput out = planner_.step(in);
+  ++steps_;
+  if (out.mode == StepMode::kBraking && !had_trajectory) {
+    const double brake = config_.fallback.braking_accel_fraction * limits.max_accel;
+    const double braking_distance = velocity.squaredNorm() / (2.0 * std::max(brake, 1e-6));
+    if (nominal.conflict_distance > braking_distance + config_.defer_margin) {
+      note("avoidance deferred: no trajectory yet");
+      return publish_stats(now, solver_stats_t::DEFERRED,
+                           "no avoidance trajectory yet (" + out.reason +
+                               "); conflict still far, nominal guidance continues",
+                           &out.report);
+    }
+  }
+  const Utime t0 = to_utime(out.start_time);
+  node_.publish(channels::kRefTraj, trajectory_message(out.trajectory, t0, traj_mode(out.mode),
+                                                       config_.sample_period, now));
+  last_trajectory_ = out.trajectory;
+  last_trajectory_t0_ = t0;
+  std::string message = to_string(out.mode);
+  if (!out.reason.empty()) message += ": " + out.reason;
+  if (out.mode != StepMode::kSolved)
+    node_.log().warn("t={:.2f} s {} ({} solves, worst violation {:.3g})", t, message, out.solves,
+                     out.report.max_violation);
+  note(std::string("avoiding: ") + to_string(out.mode));
+  publish_stats(now, stats_status(out.mode), message, &out.report);
+}
+
+}  // namespace ofn::rh

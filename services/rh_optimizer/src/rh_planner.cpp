@@ -1,0 +1,148 @@
+#include "ofn/rh_optimizer/rh_planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace ofn::rh {
+namespace {
+
+constexpr double kMinHold = 2.0;        // s a braking trajectory holds the hover
+constexpr double kKeepCheckStep = 0.1;  // s between clearance samples of a kept trajectory
+constexpr double kStoppedSpeed = 1e-3;  // m/s below which the vehicle counts as hovering
+
+bool trajectory_finite(const BsplineTrajectory& trajectory) {
+  if (trajectory.empty() || !std::isfinite(trajectory.duration())) return false;
+  for (const Vec3& c : trajectory.control_points())
+    if (!c.allFinite()) return false;
+  return true;
+}
+
+}  // namespace
+
+const char* to_string(StepMode mode) {
+  switch (mode) {
+    case StepMode::kSolved:
+      return "solved";
+    case StepMode::kKeptPrevious:
+      return "kept_previous";
+    case StepMode::kBraking:
+      return "braking";
+  }
+  return "unknown";
+}
+
+RhPlanner::RhPlanner(RhSettings settings, FallbackSettings fallback)
+    : optimizer_(settings), fallback_(fallback) {}
+
+void RhPlanner::reset() {
+  previous_ = BsplineTrajectory();
+  previous_start_ = 0;
+}
+
+BsplineTrajectory RhPlanner::braking_trajectory(const RhProblem& problem) const {
+  // The exact constant-deceleration profile: a quadratic B-spline whose first
+  // knot interval is the deceleration (a parabola from the state to the stop
+  // point, which lies at v t_stop / 2) and whose second is the hover.
+  Vec3 position = problem.position.allFinite() ? problem.position : Vec3::Zero();
+  Vec3 velocity = problem.velocity.allFinite() ? problem.velocity : Vec3::Zero();
+  const double limit = problem.limits.max_accel * fallback_.braking_accel_fraction;
+  const double decel = std::isfinite(limit) && limit > 1e-6 ? limit : 1.0;
+  const double speed = velocity.norm();
+  const double stop_time = speed > kStoppedSpeed ? speed / decel : 0.0;
+  if (stop_time == 0.0) velocity.setZero();
+  const double hold = std::max(kMinHold, stop_time);
+  const double duration = stop_time + hold;
+  const Vec3 stop = position + 0.5 * velocity * stop_time;
+  // A hover needs no deceleration piece; any interior knot gives the same
+  // constant trajectory.
+  const double knot = stop_time > 0 ? stop_time / duration : 0.5;
+  return BsplineTrajectory(2, {0, 0, 0, knot, 1, 1, 1}, {position, stop, stop, stop}, duration);
+}
+
+StepOutput RhPlanner::step(const StepInput& input) {
+  StepOutput out;
+  const RhProblem& problem = input.problem;
+  auto brake = [&](const std::string& why) {
+    out.mode = StepMode::kBraking;
+    out.trajectory = braking_trajectory(problem);
+    out.start_time = std::isfinite(input.time) ? input.time : 0.0;
+    out.reason = why;
+    return out;
+  };
+
+  const bool state_finite = problem.position.allFinite() && problem.velocity.allFinite() &&
+                            problem.acceleration.allFinite() && std::isfinite(input.time);
+  if (!state_finite) return brake("non-finite state or time");
+
+  if (problem.clearance) {
+    const double start_clearance = problem.clearance(problem.position).distance;
+    const double inside = fallback_.start_inside_fraction * problem.limits.clearance;
+    if (!(start_clearance >= inside)) {
+      std::ostringstream why;
+      why << "start clearance " << start_clearance << " m below " << inside
+          << " m: not solved from inside the safety radius";
+      return brake(why.str());
+    }
+  }
+
+  const double max_speed = problem.limits.max_speed;
+  const double cruise = std::max(0.5 * max_speed, std::min(problem.velocity.norm(), max_speed));
+  auto cold_guess = [&]() {
+    return input.global_path.empty()
+               ? RhOptimizer::guess_straight(problem)
+               : RhOptimizer::guess_from_path(input.global_path, problem, cruise);
+  };
+
+  const bool warm = has_previous() && !input.global_path_changed;
+  InitialGuess guess =
+      warm ? RhOptimizer::guess_from_previous(previous_, input.time - previous_start_, problem)
+           : cold_guess();
+  if (guess.positions.empty()) guess = cold_guess();
+  out.report = optimizer_.solve(problem, guess);
+  out.solves = 1;
+  if (!out.report.feasible && guess.warm && fallback_.cold_retry) {
+    out.report = optimizer_.solve(problem, cold_guess());
+    out.solves = 2;
+  }
+
+  if (out.report.feasible && trajectory_finite(out.report.trajectory)) {
+    out.mode = StepMode::kSolved;
+    out.trajectory = out.report.trajectory;
+    out.start_time = input.time;
+    previous_ = out.report.trajectory;
+    previous_start_ = input.time;
+    return out;
+  }
+
+  const std::string failure = "solve failed (" + out.report.message + ")";
+  if (!has_previous()) return brake(failure + "; no previous trajectory");
+  const double elapsed = input.time - previous_start_;
+  const double remaining = previous_.duration() - elapsed;
+  if (remaining < fallback_.keep_min_remaining) {
+    std::ostringstream why;
+    why << failure << "; previous has " << std::max(remaining, 0.0) << " s left, needs "
+        << fallback_.keep_min_remaining;
+    return brake(why.str());
+  }
+  if (problem.clearance) {
+    const int samples = std::max(2, static_cast<int>(std::ceil(remaining / kKeepCheckStep)));
+    for (int k = 0; k <= samples; ++k) {
+      const double t = elapsed + remaining * k / samples;
+      const double clearance = problem.clearance(previous_.position(t)).distance;
+      if (!(clearance >= problem.limits.clearance)) {
+        std::ostringstream why;
+        why << failure << "; previous comes within " << clearance << " m of an obstacle at " << t
+            << " s";
+        return brake(why.str());
+      }
+    }
+  }
+  out.mode = StepMode::kKeptPrevious;
+  out.trajectory = previous_;
+  out.start_time = previous_start_;
+  out.reason = failure + "; keeping the previous trajectory";
+  return out;
+}
+
+}  // namespace ofn::rh

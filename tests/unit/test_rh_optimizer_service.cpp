@@ -1,0 +1,242 @@
+// The RH optimiser on the bus: nominal guidance while the way ahead is
+// clear, avoidance trajectories as soon as a detected obstacle conflicts with
+// it, a NOMINAL hand-back once clear again; bad input rejected and counted.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "ofn/common/channels.hpp"
+#include "ofn/common/clock.hpp"
+#include "ofn/common/logging.hpp"
+#include "ofn/common/node.hpp"
+#include "ofn/rh_optimizer/rh_optimizer_service.hpp"
+
+namespace ofn::rh {
+namespace {
+
+constexpr Utime kStart = 10 * kMicrosPerSecond;
+constexpr double kAltitude = 36.6;  // m, 120 ft
+constexpr double kSpeed = 3.048;    // m/s, 10 ft/s
+
+mission_t mission() {
+  mission_t m{};
+  m.utime = kStart;
+  m.mission_id = 1;
+  m.name = "wall";
+  m.frame = "NED";
+  m.cruise_speed = kSpeed;
+  m.limits.max_speed = kSpeed;
+  m.limits.max_accel = 0.48768;
+  m.limits.max_vertical_speed = 1.524;
+  m.limits.min_forward_speed = 0;
+  m.limits.clearance = 6.096;
+  m.limits.sensor_range = 60.96;
+  for (double north : {-30.48, 152.4}) {
+    waypoint_t w{};
+    w.position[0] = north;
+    w.position[2] = -kAltitude;
+    w.capture_radius = 3.0;
+    m.waypoints.push_back(w);
+  }
+  m.num_waypoints = 2;
+  return m;
+}
+
+nav_state_t nav(Utime t, const Vec3& position, const Vec3& velocity = Vec3(kSpeed, 0, 0)) {
+  nav_state_t m{};
+  m.utime = t;
+  m.frame = "NED";
+  for (int i = 0; i < 3; ++i) {
+    m.position[i] = position[i];
+    m.velocity[i] = velocity[i];
+  }
+  m.quaternion[0] = 1;
+  return m;
+}
+
+/// A 40 m wide, 3 m thick wall `top` m tall with its near face at `north`,
+/// in a grid around the vehicle; top = 0 gives an empty grid.
+obstacle_grid_t grid(Utime t, double north, double top) {
+  obstacle_grid_t m{};
+  m.utime = t;
+  m.frame = "NED";
+  m.origin[0] = -20;
+  m.origin[1] = -40;
+  m.resolution = 1.0;
+  m.safety_margin = 1.5;
+  m.rows = 120;
+  m.cols = 80;
+  m.num_cells = m.rows * m.cols;
+  m.top_altitude.assign(m.num_cells, 0.0f);
+  if (top > 0)
+    for (int r = 0; r < m.rows; ++r) {
+      const double n = m.origin[0] + r + 0.5;
+      if (n < north || n > north + 3) continue;
+      for (int c = 20; c < 60; ++c) m.top_altitude[r * m.cols + c] = static_cast<float>(top);
+    }
+  return m;
+}
+
+/// The global planner's route over the wall (nodes at the clearance above
+/// its top), every 2 m.
+global_path_t route_over(Utime t) {
+  const std::vector<Vec3> nodes = {Vec3(0, 0, -kAltitude), Vec3(38.9, 0, -48.8),
+                                   Vec3(54.1, 0, -48.8), Vec3(152.4, 0, -kAltitude)};
+  global_path_t m{};
+  m.utime = t;
+  m.frame = "NED";
+  m.status = global_path_t::OK;
+  for (size_t i = 1; i < nodes.size(); ++i) {
+    const Vec3 d = nodes[i] - nodes[i - 1];
+    const int n = static_cast<int>(std::ceil(d.norm() / 2.0));
+    for (int k = 0; k < n; ++k) {
+      const Vec3 p = nodes[i - 1] + d * (static_cast<double>(k) / n);
+      m.points.push_back({p.x(), p.y(), p.z()});
+    }
+  }
+  m.points.push_back({nodes.back().x(), nodes.back().y(), nodes.back().z()});
+  m.num_points = static_cast<int32_t>(m.points.size());
+  m.cost = 200;
+  return m;
+}
+
+class RhOptimizerServiceTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { set_log_level("error"); }
+  static void TearDownTestSuite() { set_log_level("info"); }
+
+  RhOptimizerServiceTest()
+      : lcm_("memq://"),
+        clock_(kStart),
+        service_(lcm_, clock_, config()),
+        bus_("bus", lcm_, clock_) {
+    bus_.subscribe<ref_traj_t>(channels::kRefTraj,
+                               [this](const ref_traj_t& m) { trajs_.push_back(m); });
+    bus_.subscribe<solver_stats_t>(channels::kSolverStats,
+                                   [this](const solver_stats_t& m) { stats_.push_back(m); });
+  }
+  static RhOptimizerServiceConfig config() {
+    auto reader = YamlReader::empty("(defaults)");
+    return load_rh_optimizer_config(reader);
+  }
+  void deliver() {
+    while (lcm_.handleTimeout(0) > 0) {
+    }
+  }
+  /// Moves the clock to t, firing the optimiser's ticks on the way.
+  void advance_to(Utime t) {
+    while (true) {
+      const Utime next = service_.node().next_deadline();
+      if (next == INT64_MIN) {
+        service_.node().fire_due_timers(clock_.now());
+      } else if (next <= t) {
+        clock_.set(std::max(clock_.now(), next));
+        service_.node().fire_due_timers(clock_.now());
+      } else {
+        break;
+      }
+      deliver();
+    }
+    clock_.set(t);
+    deliver();
+  }
+  template <class Msg>
+  void send(const std::string& channel, const Msg& m) {
+    lcm_.publish(channel, &m);
+    deliver();
+  }
+  /// One 0.1 s step with fresh nav and grid just before the tick.
+  void step(const Vec3& position, double wall_north, double wall_top,
+            const Vec3& velocity = Vec3(kSpeed, 0, 0)) {
+    const Utime t = clock_.now() + 50000;
+    advance_to(t);
+    send(channels::kNavState, nav(t, position, velocity));
+    send(channels::kObstacleGrid, grid(t, wall_north, wall_top));
+    advance_to(t + 50000);
+  }
+
+  lcm::LCM lcm_;
+  ManualClock clock_;
+  RhOptimizerService service_;
+  Node bus_;
+  std::vector<ref_traj_t> trajs_;
+  std::vector<solver_stats_t> stats_;
+};
+
+TEST_F(RhOptimizerServiceTest, ClearWayAheadLeavesNominalGuidanceAlone) {
+  send(channels::kMission, mission());
+  for (int i = 0; i < 10; ++i) step(Vec3(kSpeed * 0.1 * i, 0, -kAltitude), 0, 0);
+  EXPECT_FALSE(service_.engaged());
+  EXPECT_TRUE(trajs_.empty());
+  ASSERT_FALSE(stats_.empty());
+  EXPECT_EQ(stats_.back().status, solver_stats_t::NOT_RUN);
+}
+
+TEST_F(RhOptimizerServiceTest, AWallAheadEngagesAvoidanceOverIt) {
+  send(channels::kMission, mission());
+  send(channels::kGlobalPath, route_over(clock_.now()));
+  for (int i = 0; i < 5; ++i) step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
+  ASSERT_TRUE(service_.engaged());
+  ASSERT_FALSE(trajs_.empty());
+  const ref_traj_t& t = trajs_.back();
+  EXPECT_EQ(t.mode, ref_traj_t::AVOIDANCE);
+  EXPECT_GE(t.num_samples, 2);
+  EXPECT_GT(t.num_control_points, 0);
+  // It starts where the vehicle is and climbs above the wall top plus the
+  // clearance by the time it is over the wall.
+  EXPECT_NEAR(t.position.front()[0], 0.0, 0.5);
+  double altitude_over_wall = 0;
+  for (size_t i = 0; i < t.position.size(); ++i)
+    if (t.position[i][0] >= 45.0 && t.position[i][0] <= 48.0)
+      altitude_over_wall = std::max(altitude_over_wall, -t.position[i][2]);
+  EXPECT_GE(altitude_over_wall, 42.7 + 6.096);
+  ASSERT_FALSE(stats_.empty());
+  EXPECT_EQ(stats_.back().status, solver_stats_t::SOLVED);
+  EXPECT_GT(stats_.back().iterations, 0);
+}
+
+TEST_F(RhOptimizerServiceTest, HandsBackWithANominalTrajectoryOnceClearAndOnTheLeg) {
+  send(channels::kMission, mission());
+  for (int i = 0; i < 3; ++i) step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
+  ASSERT_TRUE(service_.engaged());
+  // The wall is gone and the vehicle is on the leg: after the hold, back.
+  for (int i = 0; i < 20 && service_.engaged(); ++i) step(Vec3(1.0 + 0.3 * i, 0, -kAltitude), 0, 0);
+  EXPECT_FALSE(service_.engaged());
+  ASSERT_FALSE(trajs_.empty());
+  EXPECT_EQ(trajs_.back().mode, ref_traj_t::NOMINAL);
+}
+
+TEST_F(RhOptimizerServiceTest, BadInputIsRejectedCountedAndSurvived) {
+  send(channels::kMission, mission());
+  step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
+  const int64_t before = service_.node().counters().rejected;
+  obstacle_grid_t nan_grid = grid(clock_.now(), 45.0, 42.7);
+  nan_grid.top_altitude[5] = std::numeric_limits<float>::quiet_NaN();
+  send(channels::kObstacleGrid, nan_grid);
+  obstacle_grid_t wrong = grid(clock_.now(), 45.0, 42.7);
+  wrong.rows = 7;  // rows * cols != cells
+  wrong.num_cells = 7 * wrong.cols;
+  wrong.top_altitude.resize(wrong.num_cells);
+  wrong.rows = 8;
+  send(channels::kObstacleGrid, wrong);
+  send(channels::kNavState, nav(clock_.now(), Vec3(std::nan(""), 0, 0)));
+  global_path_t path{};
+  path.utime = clock_.now();
+  path.frame = "ENU";
+  send(channels::kGlobalPath, path);
+  EXPECT_GE(service_.node().counters().rejected - before, 4);
+  // Still working.
+  for (int i = 0; i < 3; ++i) step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
+  EXPECT_TRUE(service_.engaged());
+  for (const auto& t : trajs_)
+    for (const auto& p : t.position)
+      for (double v : p) EXPECT_TRUE(std::isfinite(v));
+}
+
+}  // namespace
+}  // namespace ofn::rh

@@ -1,0 +1,213 @@
+// One receding-horizon step with its warm starts and fallbacks: solved,
+// keep the previous trajectory, or brake to a hover.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "ofn/mapper/distance_field.hpp"
+#include "ofn/rh_optimizer/rh_planner.hpp"
+
+namespace ofn::rh {
+namespace {
+
+const Limits kLimits{3.048, 0.4877, 1.524, 0.0, 6.096, 60.96};  // the benchmarks' limits, SI
+constexpr double kAltitude = 30.0;
+
+// A field over north [-20, 180), east [-60, 60) with optional boxes
+// (north_lo, north_hi, east_lo, east_hi, top).
+struct Box {
+  int north_lo, north_hi, east_lo, east_hi;
+  float top;
+};
+ClearanceQuery field_with(const std::vector<Box>& boxes) {
+  mapping::Heightfield heightfield;
+  heightfield.origin_north = -20;
+  heightfield.origin_east = -60;
+  heightfield.rows = 200;
+  heightfield.cols = 120;
+  heightfield.top.assign(static_cast<size_t>(heightfield.rows) * heightfield.cols, 0.0f);
+  for (const Box& b : boxes)
+    for (int n = b.north_lo; n < b.north_hi; ++n)
+      for (int e = b.east_lo; e < b.east_hi; ++e) {
+        const int r = heightfield.row_of(n + 0.5), c = heightfield.col_of(e + 0.5);
+        if (heightfield.inside(r, c)) heightfield.at(r, c) = b.top;
+      }
+  auto field = std::make_shared<mapping::DistanceField>();
+  field->build(heightfield, 0.0, 80.0);
+  return [field](const Vec3& ned) { return field->query(ned); };
+}
+
+StepInput input_at(const Vec3& position, double time, ClearanceQuery clearance) {
+  StepInput input;
+  input.time = time;
+  RhProblem& p = input.problem;
+  p.frame = GuidanceFrame::from_leg(Vec3(0, 0, -kAltitude), Vec3(300, 0, -kAltitude));
+  p.position = position;
+  p.velocity = Vec3(kLimits.max_speed, 0, 0);
+  p.target = Vec3(300, 0, -kAltitude);
+  p.terminal_x = position.x() + kLimits.sensor_range;
+  p.limits = kLimits;
+  p.clearance = std::move(clearance);
+  return input;
+}
+
+bool finite(const BsplineTrajectory& trajectory) {
+  if (trajectory.empty() || !std::isfinite(trajectory.duration())) return false;
+  for (const Vec3& c : trajectory.control_points())
+    if (!c.allFinite()) return false;
+  return true;
+}
+
+TEST(RhPlanner, SolvesACleanProblemAndWarmStartsTheNext) {
+  RhPlanner planner;
+  const StepInput first = input_at(Vec3(0, 0, -kAltitude), 10.0, field_with({}));
+  const StepOutput out = planner.step(first);
+  ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
+  EXPECT_EQ(out.solves, 1);
+  EXPECT_DOUBLE_EQ(out.start_time, 10.0);
+  EXPECT_TRUE(finite(out.trajectory));
+  EXPECT_FALSE(out.report.warm_started);
+  EXPECT_TRUE(planner.has_previous());
+
+  StepInput second = input_at(out.trajectory.position(0.1), 10.1, field_with({}));
+  second.problem.velocity = out.trajectory.velocity(0.1);
+  second.problem.acceleration = out.trajectory.acceleration(0.1);
+  const StepOutput next = planner.step(second);
+  ASSERT_EQ(next.mode, StepMode::kSolved) << next.reason;
+  EXPECT_TRUE(next.report.warm_started);
+  EXPECT_DOUBLE_EQ(next.start_time, 10.1);
+
+  // A new route makes the next guess cold again.
+  StepInput rerouted = second;
+  rerouted.time = 10.2;
+  rerouted.global_path_changed = true;
+  rerouted.global_path = {Vec3(0, 0, -kAltitude), Vec3(300, 0, -kAltitude)};
+  const StepOutput cold = planner.step(rerouted);
+  ASSERT_EQ(cold.mode, StepMode::kSolved) << cold.reason;
+  EXPECT_FALSE(cold.report.warm_started);
+
+  planner.reset();
+  EXPECT_FALSE(planner.has_previous());
+}
+
+TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {
+  RhPlanner planner;
+  const ClearanceQuery open = field_with({});
+  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 5.0, open));
+  ASSERT_EQ(first.mode, StepMode::kSolved);
+
+  // A terminal x out of reach within max_duration at max_speed.
+  StepInput impossible = input_at(first.trajectory.position(0.5), 5.5, open);
+  impossible.problem.velocity = first.trajectory.velocity(0.5);
+  impossible.problem.terminal_x = 1000.0;
+  const StepOutput out = planner.step(impossible);
+  EXPECT_EQ(out.mode, StepMode::kKeptPrevious) << out.reason;
+  EXPECT_EQ(out.solves, 2);  // the warm solve and the cold retry
+  EXPECT_DOUBLE_EQ(out.start_time, 5.0);
+  EXPECT_EQ(out.trajectory.control_points(), first.trajectory.control_points());
+  EXPECT_FALSE(out.reason.empty());
+
+  // Without the retry only one solve runs.
+  RhPlanner no_retry(RhSettings{}, FallbackSettings{0.5, 2.0, 0.8, false});
+  ASSERT_EQ(no_retry.step(input_at(Vec3(0, 0, -kAltitude), 5.0, open)).mode, StepMode::kSolved);
+  EXPECT_EQ(no_retry.step(impossible).solves, 1);
+}
+
+TEST(RhPlanner, KeepsThePreviousWhenTheIterationLimitStopsTheSolve) {
+  RhSettings one_evaluation;
+  one_evaluation.max_iterations = 1;
+  RhPlanner planner(one_evaluation);
+  // Straight and level at cruise speed: the straight guess is itself feasible.
+  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+  ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
+
+  // A new zig-zag route: one evaluation of its guess cannot be feasible.
+  StepInput later = input_at(first.trajectory.position(0.3), 0.3, field_with({}));
+  later.global_path_changed = true;
+  later.global_path = {Vec3(0, 0, -kAltitude), Vec3(15, 20, -kAltitude), Vec3(30, -20, -kAltitude),
+                       Vec3(300, 0, -kAltitude)};
+  const StepOutput out = planner.step(later);
+  EXPECT_EQ(out.mode, StepMode::kKeptPrevious) << out.reason;
+  EXPECT_EQ(out.report.iterations, 1);
+  EXPECT_EQ(out.solves, 1);  // a cold guess is not retried
+  EXPECT_DOUBLE_EQ(out.start_time, 0.0);
+}
+
+TEST(RhPlanner, BrakesWhenTheStartIsInsideTheClearance) {
+  RhPlanner planner;
+  // A tall wall 2 m ahead of the vehicle.
+  const ClearanceQuery wall = field_with({{2, 4, -60, 60, 70.0f}});
+  const StepInput input = input_at(Vec3(0, 0, -kAltitude), 3.0, wall);
+  ASSERT_LT(input.problem.clearance(input.problem.position).distance, 0.5 * kLimits.clearance);
+  const StepOutput out = planner.step(input);
+  EXPECT_EQ(out.mode, StepMode::kBraking);
+  EXPECT_EQ(out.solves, 0);
+  EXPECT_EQ(out.report.iterations, 0);
+  EXPECT_DOUBLE_EQ(out.start_time, 3.0);
+  EXPECT_FALSE(out.reason.empty());
+  EXPECT_LT((out.trajectory.position(0) - input.problem.position).norm(), 1e-9);
+  EXPECT_LT((out.trajectory.velocity(0) - input.problem.velocity).norm(), 1e-9);
+}
+
+TEST(RhPlanner, BrakesWhenThePreviousRunsIntoANewObstacle) {
+  RhPlanner planner;
+  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+  ASSERT_EQ(first.mode, StepMode::kSolved);
+  // A wall across the whole map, higher than the field, pops up 25 m ahead:
+  // no solution passes it and the previous trajectory runs into it.
+  const ClearanceQuery wall = field_with({{25, 28, -60, 60, 200.0f}});
+  StepInput input = input_at(first.trajectory.position(0.2), 0.2, wall);
+  input.problem.velocity = first.trajectory.velocity(0.2);
+  const StepOutput out = planner.step(input);
+  EXPECT_EQ(out.mode, StepMode::kBraking) << out.reason;
+  EXPECT_NE(out.reason.find("previous"), std::string::npos) << out.reason;
+  EXPECT_TRUE(finite(out.trajectory));
+  EXPECT_DOUBLE_EQ(out.start_time, 0.2);
+}
+
+TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
+  const FallbackSettings fallback;
+  const RhPlanner planner(RhSettings{}, fallback);
+  const double limit = fallback.braking_accel_fraction * kLimits.max_accel;
+  for (const Vec3& velocity : {Vec3(3.0, 0, 0), Vec3(1.5, -2.0, 0.8), Vec3(0, 0, 0)}) {
+    RhProblem problem;
+    problem.position = Vec3(10, -4, -25);
+    problem.velocity = velocity;
+    problem.acceleration = Vec3(0.3, 0.1, 0);
+    problem.limits = kLimits;
+    const BsplineTrajectory braking = planner.braking_trajectory(problem);
+    ASSERT_TRUE(finite(braking));
+    EXPECT_LT((braking.position(0) - problem.position).norm(), 1e-9);
+    EXPECT_LT((braking.velocity(0) - velocity).norm(), 1e-9);
+    const double T = braking.duration();
+    EXPECT_LT(braking.velocity(T).norm(), 1e-9);
+    EXPECT_LT(braking.velocity(T + 5.0).norm(), 1e-9);
+    for (int k = 0; k <= 500; ++k) {
+      const double t = T * k / 500.0;
+      EXPECT_LE(braking.acceleration(t).norm(), limit + 1e-9) << "t " << t;
+      // Decelerating along the velocity: never turning or speeding up.
+      if (velocity.norm() > 0) {
+        EXPECT_GE(braking.velocity(t).dot(velocity), -1e-9);
+        EXPECT_LE(braking.velocity(t).norm(), velocity.norm() + 1e-9);
+      }
+    }
+    // The stop lies v^2 / (2 a) along the velocity.
+    const Vec3 expected_stop = problem.position + velocity * (velocity.norm() / (2.0 * limit));
+    EXPECT_LT((braking.position(T) - expected_stop).norm(), 1e-9);
+  }
+}
+
+TEST(RhPlanner, NonFiniteInputBrakesWithoutNaN) {
+  RhPlanner planner;
+  StepInput input = input_at(Vec3(0, 0, -kAltitude), 1.0, field_with({}));
+  input.problem.velocity.y() = std::nan("");
+  const StepOutput out = planner.step(input);
+  EXPECT_EQ(out.mode, StepMode::kBraking);
+  EXPECT_TRUE(finite(out.trajectory));
+  EXPECT_STREQ(to_string(StepMode::kKeptPrevious), "kept_previous");
+}
+
+}  // namespace
+}  // namespace ofn::rh
