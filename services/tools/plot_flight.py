@@ -104,6 +104,30 @@ def obstacle_footprint(ob):
     return [(cn + x * c - y * s, ce + x * s + y * c) for x, y in local]
 
 
+def draw_plans(ax, k, gpath, ref, axis, sign):
+    """Planned routes against north: every global path faintly, the one that
+    strays furthest from the straight line (the route round or over the
+    obstacles) boldly, and the RH optimiser's trajectories as thin lines."""
+    if gpath is not None and nrows(gpath) and "seq" in gpath:
+        seq = col(gpath, "seq")
+        best, best_dev = None, 0.0
+        for s_id in np.unique(seq):
+            sel = seq == s_id
+            n, v = gpath["north"][sel], gpath[axis][sel]
+            ax.plot(n * k, sign * v * k, "-", color="tab:green", lw=0.4, alpha=0.25)
+            dev = np.nanmax(np.abs(v - v[0])) if len(v) else 0.0
+            if best is None or dev > best_dev:
+                best, best_dev = sel, dev
+        ax.plot(gpath["north"][best] * k, sign * gpath[axis][best] * k, "--",
+                color="tab:green", lw=1.2, label="global path")
+    if ref is not None and nrows(ref) and "seq" in ref:
+        seq = col(ref, "seq")
+        for i, s_id in enumerate(np.unique(seq)):
+            sel = seq == s_id
+            ax.plot(ref["north"][sel] * k, sign * ref[axis][sel] * k, "-", color="tab:orange",
+                    lw=0.5, alpha=0.6, label="RH trajectories" if i == 0 else None)
+
+
 def panel_top_view(ax, k, nav, ctl, wps, summary, gpath, ref, scan, cuboids):
     for ob in summary.get("obstacles") or []:
         cn, ce = ob["center"]
@@ -123,15 +147,7 @@ def panel_top_view(ax, k, nav, ctl, wps, summary, gpath, ref, scan, cuboids):
     if scan is not None and nrows(scan):
         ax.plot(col(scan, "north") * k, col(scan, "east") * k, ".", ms=1,
                 color="0.6", label="LIDAR hits")
-    if gpath is not None and nrows(gpath):
-        # Paths are replanned over time; only the last one is the one flown to.
-        t = col(gpath, "t")
-        last = t == np.nanmax(t)
-        ax.plot(gpath["north"][last] * k, gpath["east"][last] * k, "--",
-                color="tab:green", lw=1, label="global path (last)")
-    if ref is not None and nrows(ref):
-        ax.plot(col(ref, "north") * k, col(ref, "east") * k, "-", color="tab:orange",
-                lw=0.6, label="planned reference")
+    draw_plans(ax, k, gpath, ref, "east", 1.0)
     ax.plot(col(ctl, "ref_n") * k, col(ctl, "ref_e") * k, "--", color="tab:red",
             lw=1, label="reference")
     ax.plot(col(nav, "north") * k, col(nav, "east") * k, "-", color="tab:blue",
@@ -144,7 +160,7 @@ def panel_top_view(ax, k, nav, ctl, wps, summary, gpath, ref, scan, cuboids):
     ax.autoscale_view()
 
 
-def panel_altitude(ax, k, nav, ctl, wps, summary, cuboids, scan):
+def panel_altitude(ax, k, nav, ctl, wps, summary, cuboids, scan, gpath, ref):
     for ob in summary.get("obstacles") or []:
         if ob.get("kind") in ("cylinder", "tree"):
             r = 0.5 * float(ob["size"][0])
@@ -167,6 +183,7 @@ def panel_altitude(ax, k, nav, ctl, wps, summary, cuboids, scan):
     if scan is not None and nrows(scan):
         ax.plot(col(scan, "north") * k, -col(scan, "down") * k, ".", ms=1, color="0.6",
                 label="LIDAR hits")
+    draw_plans(ax, k, gpath, ref, "down", -1.0)
     ax.plot(col(ctl, "ref_n") * k, -col(ctl, "ref_d") * k, "--", color="tab:red",
             lw=1, label="reference")
     ax.plot(col(nav, "north") * k, -col(nav, "down") * k, "-", color="tab:blue",
@@ -307,7 +324,7 @@ def main():
 
     panel_top_view(ax_top, k, nav, ctl, wps, summary, gpath, ref, scan, cuboids)
     ax_top.set(xlabel="x (north) [%s]" % unit, ylabel="y (east) [%s]" % unit, title="top view")
-    panel_altitude(ax_alt, k, nav, ctl, wps, summary, cuboids, scan)
+    panel_altitude(ax_alt, k, nav, ctl, wps, summary, cuboids, scan, gpath, ref)
     ax_alt.set(xlabel="x (north) [%s]" % unit, ylabel="h [%s]" % unit, title="altitude")
     panel_speed(ax_spd, k, nav, summary, gate_times)
     ax_spd.set(xlabel="t [s]", ylabel="speed [%s/s]" % unit, title="speed")

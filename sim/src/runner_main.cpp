@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 
@@ -14,9 +15,11 @@
 #include "ofn/common/scenario.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/controller/controller_service.hpp"
+#include "ofn/global_planner/global_planner_service.hpp"
 #include "ofn/mapper/mapper_service.hpp"
 #include "ofn/mission_uplink/mission_uplink_service.hpp"
 #include "ofn/obstacle_injector/obstacle_injector_service.hpp"
+#include "ofn/rh_optimizer/rh_optimizer_service.hpp"
 #include "ofn/sensor_interface/sensor_interface_service.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/tools/flight_report.hpp"
@@ -37,13 +40,13 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn lockstep runner: all services in one process, deterministic and fast"};
   std::string scenario_path, config_dir = "config", out_dir, log_path, log_level = "warn";
   double max_time = 0, linger = 2.0;
-  bool quiet = false;
+  bool quiet = false, no_avoidance = false;
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--config-dir", config_dir,
-                 "folder with the services' config files, e.g. vehicle_sim.yaml and "
-                 "mapper.yaml (missing files: defaults)");
+                 "folder with the services' config files, e.g. vehicle_sim.yaml, "
+                 "mapper.yaml, global_planner.yaml, rh_optimizer.yaml (missing files: defaults)");
   app.add_option("--out", out_dir, "folder for the log, CSV files and summary (default: none)");
   app.add_option("--log", log_path, "LCM log to write (default: <out>/flight.lcm)");
   app.add_option("--max-time", max_time, "simulated seconds before giving up (default: scenario)")
@@ -52,6 +55,8 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "service log level")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.add_flag("--quiet", quiet, "no progress lines");
+  app.add_flag("--no-avoidance", no_avoidance,
+               "fly without global_planner and rh_optimizer (nominal waypoint guidance only)");
   app.failure_message(CLI::FailureMessage::help);
   CLI11_PARSE(app, argc, argv);
 
@@ -65,10 +70,13 @@ int main(int argc, char** argv) {
     auto injector_reader = config_in(config_dir, "obstacle_injector.yaml");
     auto sensor_reader = config_in(config_dir, "sensor_interface.yaml");
     auto mapper_reader = config_in(config_dir, "mapper.yaml");
-    const auto injector_config =
-        ofn::injector::load_obstacle_injector_config(injector_reader);
+    const auto injector_config = ofn::injector::load_obstacle_injector_config(injector_reader);
     const auto sensor_config = ofn::sensing::load_sensor_interface_config(sensor_reader);
     const auto mapper_config = ofn::mapping::load_mapper_config(mapper_reader);
+    auto planner_reader = config_in(config_dir, "global_planner.yaml");
+    auto optimizer_reader = config_in(config_dir, "rh_optimizer.yaml");
+    const auto planner_config = ofn::planning::load_global_planner_config(planner_reader);
+    const auto optimizer_config = ofn::rh::load_rh_optimizer_config(optimizer_reader);
     if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
     if (log_path.empty() && !out_dir.empty()) log_path = out_dir + "/flight.lcm";
 
@@ -78,13 +86,21 @@ int main(int argc, char** argv) {
                                             vehicle_config);
     ofn::uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), scenario_path);
     ofn::control::ControllerService controller(lockstep.lcm(), lockstep.clock(), controller_config);
-    ofn::injector::ObstacleInjectorService injector(lockstep.lcm(), lockstep.clock(),
-                                                    scenario_path, injector_config);
+    ofn::injector::ObstacleInjectorService injector(lockstep.lcm(), lockstep.clock(), scenario_path,
+                                                    injector_config);
     ofn::sensing::SensorInterfaceService sensor(lockstep.lcm(), lockstep.clock(), sensor_config);
     ofn::mapping::MapperService mapper(lockstep.lcm(), lockstep.clock(), mapper_config);
     for (ofn::Node* node : {&vehicle.node(), &uplink.node(), &controller.node(), &injector.node(),
                             &sensor.node(), &mapper.node()})
       lockstep.add(*node);
+    std::optional<ofn::planning::GlobalPlannerService> planner;
+    std::optional<ofn::rh::RhOptimizerService> optimizer;
+    if (!no_avoidance) {
+      planner.emplace(lockstep.lcm(), lockstep.clock(), planner_config);
+      optimizer.emplace(lockstep.lcm(), lockstep.clock(), optimizer_config);
+      lockstep.add(planner->node());
+      lockstep.add(optimizer->node());
+    }
 
     const double limit = max_time > 0 ? max_time : scenario.max_time;
     ofn::Utime done_at = INT64_MIN;

@@ -1,5 +1,7 @@
 #include "ofn/tools/flight_report.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -14,10 +16,13 @@
 #include "ofn/common/clock.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/cuboid_list_t.hpp"
+#include "ofn/global_path_t.hpp"
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
+#include "ofn/ref_traj_t.hpp"
 #include "ofn/scan_world_t.hpp"
+#include "ofn/solver_stats_t.hpp"
 #include "ofn/world/world.hpp"
 
 namespace ofn::report {
@@ -25,6 +30,16 @@ namespace {
 
 Vec3 vec(const double (&a)[3]) {
   return Vec3(a[0], a[1], a[2]);
+}
+
+/// The q-quantile (0..1, nearest rank) of the values; none when empty.
+std::optional<double> percentile(std::vector<double> values, double q) {
+  if (values.empty()) return std::nullopt;
+  std::sort(values.begin(), values.end());
+  const size_t i = std::min(
+      values.size() - 1,
+      static_cast<size_t>(std::ceil(q * values.size()) > 0 ? std::ceil(q * values.size()) - 1 : 0));
+  return values[i];
 }
 
 template <class Msg>
@@ -92,6 +107,16 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   auto scan_csv = open_csv(out / "scan_points.csv", "t,north,east,down");
   size_t scan_points_seen = 0, scan_points_written = 0;
   std::optional<cuboid_list_t> last_cuboids;
+  // Planning: every global path, every n-th avoidance trajectory (a 10 Hz
+  // optimiser would otherwise paint a solid band), every solver report.
+  constexpr int kRefTrajStride = 5;
+  auto path_csv = open_csv(out / "global_path.csv", "t,seq,status,cost,north,east,down");
+  auto ref_csv = open_csv(out / "ref_traj.csv", "t,seq,mode,sample_t,north,east,down");
+  auto stats_csv = open_csv(out / "solver_stats.csv",
+                            "t,status,iterations,solve_time,max_violation,cost,warm_started");
+  int path_seq = 0, ref_seq = 0, ref_seen = 0;
+  std::vector<double> solve_times;
+  std::map<int, int> solver_status_count;
   auto row = [](std::ofstream& f, std::initializer_list<Vec3> vs) {
     for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
   };
@@ -152,6 +177,33 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       cuboid_list_t m{};
       if (!decode(e, m)) return false;
       last_cuboids = std::move(m);
+    } else if (channel == channels::kGlobalPath) {
+      global_path_t m{};
+      if (!decode(e, m)) return false;
+      for (const auto& p : m.points)
+        path_csv << rel(m.utime) << "," << path_seq << "," << static_cast<int>(m.status) << ","
+                 << m.cost << "," << p[0] << "," << p[1] << "," << p[2] << "\n";
+      ++path_seq;
+    } else if (channel == channels::kRefTraj) {
+      ref_traj_t m{};
+      if (!decode(e, m)) return false;
+      if (m.mode != ref_traj_t::NOMINAL && ref_seen++ % kRefTrajStride == 0) {
+        for (size_t i = 0; i < m.sample_time.size(); ++i)
+          ref_csv << rel(m.utime) << "," << ref_seq << "," << static_cast<int>(m.mode) << ","
+                  << rel(m.t0_utime) + m.sample_time[i] << "," << m.position[i][0] << ","
+                  << m.position[i][1] << "," << m.position[i][2] << "\n";
+        ++ref_seq;
+      }
+    } else if (channel == channels::kSolverStats) {
+      solver_stats_t m{};
+      if (!decode(e, m)) return false;
+      stats_csv << rel(m.utime) << "," << static_cast<int>(m.status) << "," << m.iterations << ","
+                << m.solve_time << "," << m.max_constraint_violation << "," << m.cost << ","
+                << (m.warm_started ? 1 : 0) << "\n";
+      if (m.status != solver_stats_t::NOT_RUN) {
+        ++solver_status_count[m.status];
+        solve_times.push_back(m.solve_time);
+      }
     } else if (channel == channels::kMission) {
       mission_t m{};
       if (!decode(e, m)) return false;
@@ -212,8 +264,8 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       for (const auto& c : last_cuboids->cuboids)
         cuboid_csv << rel(last_cuboids->utime) << "," << c.id << "," << c.min_corner[0] << ","
                    << c.min_corner[1] << "," << c.min_corner[2] << "," << c.max_corner[0] << ","
-                   << c.max_corner[1] << "," << c.max_corner[2] << ","
-                   << (c.top_observed ? 1 : 0) << "," << c.confidence << "\n";
+                   << c.max_corner[1] << "," << c.max_corner[2] << "," << (c.top_observed ? 1 : 0)
+                   << "," << c.confidence << "\n";
   }
   // True clearance: distance from the flown path to the real obstacle
   // surfaces (present at that time), over the whole flight.
@@ -266,6 +318,13 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"min_clearance\": " << json_number(min_clearance) << ",\n"
        << "  \"min_clearance_t\": " << json_number(min_clearance_t) << ",\n"
        << "  \"clearance_required\": " << limits.clearance << ",\n"
+       << "  \"rh_steps\": " << solve_times.size() << ",\n"
+       << "  \"rh_solve_time_median\": " << json_number(percentile(solve_times, 0.5)) << ",\n"
+       << "  \"rh_solve_time_p99\": " << json_number(percentile(solve_times, 0.99)) << ",\n"
+       << "  \"rh_solve_time_max\": " << json_number(percentile(solve_times, 1.0)) << ",\n"
+       << "  \"rh_kept_previous\": " << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ",\n"
+       << "  \"rh_braking\": " << solver_status_count[solver_stats_t::BRAKING] << ",\n"
+       << "  \"rh_deferred\": " << solver_status_count[solver_stats_t::DEFERRED] << ",\n"
        << "  \"obstacles\": [";
   if (scenario) {
     // Metres, like every other length in this file (the plot scales them).
@@ -307,15 +366,29 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   t << "  tracking error    : RMS " << s.tracking_rms / k << " " << unit << ", max "
     << s.tracking_max / k << " " << unit << "\n";
   if (min_clearance)
-    t << "  least clearance   : " << *min_clearance / k << " " << unit << " to a real obstacle at t = "
-      << *min_clearance_t << " s (required " << limits.clearance / k << ")\n";
+    t << "  least clearance   : " << *min_clearance / k << " " << unit
+      << " to a real obstacle at t = " << *min_clearance_t << " s (required "
+      << limits.clearance / k << ")\n";
   if (last_cuboids)
     t << "  obstacle database : " << last_cuboids->num_cuboids << " cuboids at the end, "
       << scan_points_seen << " LIDAR points mapped\n";
+  if (!solve_times.empty()) {
+    t << "  RH optimiser      : " << solve_times.size() << " steps, solve time median "
+      << std::setprecision(1) << 1e3 * *percentile(solve_times, 0.5) << " ms, p99 "
+      << 1e3 * *percentile(solve_times, 0.99) << " ms, max " << 1e3 * *percentile(solve_times, 1.0)
+      << std::setprecision(2) << " ms; kept previous "
+      << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ", braking "
+      << solver_status_count[solver_stats_t::BRAKING] << ", deferred "
+      << solver_status_count[solver_stats_t::DEFERRED] << "\n";
+  } else {
+    t << "  RH optimiser      : never engaged (nominal waypoint guidance throughout)\n";
+  }
+  if (path_seq > 0) t << "  global planner    : " << path_seq << " paths published\n";
   if (result.undecodable)
     t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
   t << "  files             : " << out.string() << "/{nav_state,control_status,actuator_cmd,"
-    << "heartbeats,waypoints,scan_points,cuboids}.csv, summary.json\n";
+    << "heartbeats,waypoints,scan_points,cuboids,global_path,ref_traj,solver_stats}.csv, "
+    << "summary.json\n";
   result.text = t.str();
   std::ofstream(out / "summary.txt") << result.text;
   return result;
