@@ -34,5 +34,15 @@ echo
 echo "== tracking sweep: adaptive vs non-adaptive (airframe errors x crosswinds) =="
 "$build/bin/ofn_tracking_sweep" --out "$out" | tail -n 1
 cat "$out/tracking_sweep.md"
-python3 "$repo/bench/plot_tracking_sweep.py" "$out/tracking_sweep.csv" "$out/tracking_sweep.png" ||
+/usr/bin/python3 "$repo/bench/plot_tracking_sweep.py" "$out/tracking_sweep.csv" "$out/tracking_sweep.png" ||
   echo "(plot skipped: python3 with matplotlib needed)"
+
+echo
+echo "== planners in the loop: bench1 and bench4 in lockstep (RH solve times from the flight) =="
+for course in bench1 bench4; do
+  "$build/bin/ofn_sim_runner" --scenario "$repo/sim/scenarios/$course.yaml" \
+    --config-dir "$repo/config" --out "$out/flight-$course" --quiet > "$out/flight-$course.txt" || true
+  echo "$course:"
+  grep -E "^lockstep:|gate-to-gate|least clearance|RH optimiser|max speed|max commanded" \
+    "$out/flight-$course.txt" | sed 's/^/  /'
+done

@@ -76,7 +76,11 @@ int main(int argc, char** argv) {
     auto planner_reader = config_in(config_dir, "global_planner.yaml");
     auto optimizer_reader = config_in(config_dir, "rh_optimizer.yaml");
     const auto planner_config = ofn::planning::load_global_planner_config(planner_reader);
-    const auto optimizer_config = ofn::rh::load_rh_optimizer_config(optimizer_reader);
+    auto optimizer_config = ofn::rh::load_rh_optimizer_config(optimizer_reader);
+    // Virtual time does not advance while a solve runs, and a wall-time cap
+    // would make a run depend on the machine's load: in lockstep every solve
+    // is bounded by its evaluation count alone, so runs repeat to the bit.
+    optimizer_config.optimizer.max_solve_time = 10.0;
     if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
     if (log_path.empty() && !out_dir.empty()) log_path = out_dir + "/flight.lcm";
 

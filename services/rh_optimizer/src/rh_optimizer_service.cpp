@@ -70,6 +70,8 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
       r.number_in("route_change_distance", c.route_change_distance, 0.1, 1000.0);
   c.field_period = r.number_in("field_period", c.field_period, 0.0, 10.0);
   c.field_altitude_band = r.number_in("field_altitude_band", c.field_altitude_band, 5.0, 1000.0);
+  c.occlusion_depth = r.number_in("occlusion_depth", c.occlusion_depth, 0.0, 500.0);
+  c.visibility_band = r.number_in("visibility_band", c.visibility_band, 0.1, 100.0);
   c.planned_initial_acceleration =
       r.boolean("planned_initial_acceleration", c.planned_initial_acceleration);
   c.defer_margin = r.number_in("defer_margin", c.defer_margin, 0.0, 1000.0);
@@ -190,6 +192,7 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
       config_(std::move(config)),
       planner_(config_.optimizer, config_.fallback),
       switch_(config_.avoidance),
+      visibility_(1.0, config_.visibility_band),
       field_(config_.field) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
@@ -204,6 +207,10 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
   node_.subscribe<global_path_t>(
       channels::kGlobalPath, [this](const global_path_t& m) { on_global_path(m); },
       SubscribeOptions{config_.path_max_age, 0.5});
+  if (config_.occlusion_depth > 0)
+    node_.subscribe<scan_world_t>(
+        channels::kScanWorld, [this](const scan_world_t& m) { on_scan(m); },
+        SubscribeOptions{config_.grid_max_age, 0.5});
   node_.add_timer(
       1.0 / config_.rate, [this] { tick(); }, "rh_step");
   node_.set_state("waiting for mission, nav and grid");
@@ -220,6 +227,7 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   active_leg_ = -1;
   planner_.reset();
   switch_.reset();
+  visibility_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
                    m.mission_id, m.name, m.limits.clearance, config_.optimizer.clearance_margin,
                    m.limits.max_accel);
@@ -255,6 +263,18 @@ void RhOptimizerService::on_global_path(const global_path_t& m) {
   route_utime_ = m.utime;
 }
 
+void RhOptimizerService::on_scan(const scan_world_t& m) {
+  const Vec3 origin = vec(m.sensor_origin);
+  const double altitude = -origin.z();
+  for (const auto& p : m.points)
+    visibility_.add_beam(origin, Vec3(p[0], p[1], p[2]), true, altitude);
+  for (const auto& p : m.free_ray_ends)
+    visibility_.add_beam(origin, Vec3(p[0], p[1], p[2]), false, altitude);
+  // About every 10 s of scans: keep twice the sensor's reach around.
+  if (++scans_seen_ % 128 == 0)
+    visibility_.forget_beyond(origin, 2.0 * (mission_ ? mission_->limits.sensor_range : 100.0));
+}
+
 bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
   if (!grid_) return false;
   const double vehicle_altitude = -vehicle.z();
@@ -263,9 +283,10 @@ bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
   const bool due = field_built_ == INT64_MIN ||
                    now - field_built_ >= to_utime(config_.field_period) || band_moved;
   if (field_valid_ && !(grid_dirty_ && due) && !band_moved) return true;
-  heightfield_ = padded_heightfield(*grid_, config_.field.max_distance);
+  heightfield_ = padded_heightfield(*grid_, config_.field.max_distance + config_.occlusion_depth);
   const double ground = config_.optimizer.ground_altitude;
   const double alt = vehicle_altitude - ground;
+  cast_occlusion_shadows(heightfield_, visibility_, vehicle, alt, config_.occlusion_depth);
   const double lo = std::max(0.0, alt - config_.field_altitude_band);
   const double hi = std::max(lo + 1.0, alt + config_.field_altitude_band);
   field_.build(heightfield_, lo, hi);
@@ -374,11 +395,22 @@ void RhOptimizerService::tick() {
   p.frame = GuidanceFrame::from_leg(leg.from, leg.to);
   p.position = position;
   p.velocity = velocity;
-  p.acceleration = vec(nav_->acceleration);
-  if (config_.planned_initial_acceleration && !last_trajectory_.empty()) {
-    const double since = to_seconds(now - last_trajectory_t0_);
-    if (since >= 0 && since <= last_trajectory_.duration())
-      p.acceleration = last_trajectory_.acceleration(since);
+  // a(t0) is fixed by construction (Eq. 5) and not constrained, so what it
+  // is set to is what the trajectory starts with. The measured acceleration
+  // carries the scanner's yaw-sweep oscillation and gust noise; the planned
+  // one (or zero, as waypoint guidance commands in cruise, when avoidance
+  // has just engaged) is what the controller was following.
+  if (config_.planned_initial_acceleration) {
+    p.acceleration = Vec3::Zero();
+    if (!last_trajectory_.empty()) {
+      const double since = to_seconds(now - last_trajectory_t0_);
+      if (since >= 0 && since <= last_trajectory_.duration())
+        p.acceleration = last_trajectory_.acceleration(since);
+    }
+  } else {
+    p.acceleration = vec(nav_->acceleration);
+    const double norm = p.acceleration.norm();
+    if (norm > mission_->limits.max_accel) p.acceleration *= mission_->limits.max_accel / norm;
   }
   p.target = leg.to;
   const double x_target = p.frame.to_guidance(leg.to).x();

@@ -22,7 +22,9 @@
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
 #include "ofn/rh_optimizer/avoidance_switch.hpp"
+#include "ofn/rh_optimizer/occlusion.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
+#include "ofn/scan_world_t.hpp"
 #include "ofn/solver_stats_t.hpp"
 
 namespace ofn::rh {
@@ -36,6 +38,10 @@ struct RhOptimizerServiceConfig {
   double route_change_distance = 5.0;  // m a new global path must differ by to be a new route
   double field_period = 0.2;           // s; the distance field is rebuilt at most this often
   double field_altitude_band = 40.0;   // m of altitude above and below the vehicle in the field
+  double occlusion_depth =
+      30.0;  // m of hidden space behind a seen face taken as obstacle (0: none)
+  double visibility_band =
+      3.0;  // m around flight altitude in which a crossing beam counts as a look
   bool planned_initial_acceleration = true;  // a(t0) from the last plan, not the nav solution
   // Before a first avoidance trajectory exists, a failed solve brakes only
   // if the conflict is within braking distance plus this; otherwise nominal
@@ -78,6 +84,7 @@ class RhOptimizerService {
   void on_mission(const mission_t& m);
   void on_grid(const obstacle_grid_t& m);
   void on_global_path(const global_path_t& m);
+  void on_scan(const scan_world_t& m);
   void tick();
   bool refresh_field(Utime now, const Vec3& vehicle);
   void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
@@ -94,6 +101,8 @@ class RhOptimizerService {
   std::optional<mission_t> mission_;
   std::optional<obstacle_grid_t> grid_;
   bool grid_dirty_ = false;
+  VisibilityRecord visibility_;
+  int64_t scans_seen_ = 0;
   mapping::Heightfield heightfield_;
   mapping::DistanceField field_;
   bool field_valid_ = false;

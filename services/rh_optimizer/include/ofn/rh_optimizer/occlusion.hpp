@@ -1,0 +1,57 @@
+#pragma once
+// What the scanner has not seen is not assumed free right behind what it has
+// seen. The grid holds only surfaces the LIDAR hit: of a cube seen from the
+// front, only its front face; its sides and back come into view only once
+// the vehicle is beside or past it, and with the scanner looking ahead
+// (yaw sweep of +-20 deg) that can be when the vehicle is already turning
+// back towards the leg right behind it. So the optimiser treats the hidden
+// space behind every obstacle cell that stands above the vehicle as
+// obstacle, up to `depth` metres away from the vehicle along the line of
+// sight, stopping at the first cell a beam has crossed near flight
+// altitude (seen free there, so the obstacle does not reach it).
+// Pure core: the visibility record is fed from the scans by the service.
+
+#include <cstdint>
+#include <unordered_set>
+
+#include "ofn/common/frames.hpp"
+#include "ofn/mapper/heightfield.hpp"
+
+namespace ofn::rh {
+
+/// Horizontal cells (world-fixed, `resolution` square) that a LIDAR beam
+/// has crossed within `band` metres of the vehicle's altitude.
+class VisibilityRecord {
+ public:
+  explicit VisibilityRecord(double resolution = 1.0, double band = 3.0)
+      : resolution_(resolution), band_(band) {}
+
+  /// One beam from the sensor at `origin` to `end` (world NED); `hit`: the
+  /// end cell holds the obstacle and is not marked. `vehicle_altitude` is
+  /// the altitude (-z) the band is centred on.
+  void add_beam(const Vec3& origin, const Vec3& end, bool hit, double vehicle_altitude);
+  bool seen(double north, double east) const { return cells_.count(key(north, east)) > 0; }
+  size_t size() const { return cells_.size(); }
+  void clear() { cells_.clear(); }
+  /// Drops cells farther than `radius` horizontally from `centre`, so the
+  /// record stays the size of the neighbourhood on a long flight.
+  void forget_beyond(const Vec3& centre, double radius);
+
+ private:
+  int64_t key(double north, double east) const;
+
+  double resolution_;
+  double band_;
+  std::unordered_set<int64_t> cells_;
+};
+
+/// Raises the hidden cells behind every obstacle cell taller than
+/// `vehicle_altitude` (m above ground), along the line of sight from the
+/// vehicle, up to `depth` metres beyond the cell or to the first seen cell.
+/// Cells within `near` metres of the vehicle cast no shadow. Returns the
+/// number of cells raised.
+int cast_occlusion_shadows(mapping::Heightfield& grid, const VisibilityRecord& visibility,
+                           const Vec3& vehicle_ned, double vehicle_altitude, double depth,
+                           double near = 2.0);
+
+}  // namespace ofn::rh

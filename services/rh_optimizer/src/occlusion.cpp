@@ -1,0 +1,90 @@
+#include "ofn/rh_optimizer/occlusion.hpp"
+
+#include <cmath>
+#include <iterator>
+#include <vector>
+
+namespace ofn::rh {
+
+int64_t VisibilityRecord::key(double north, double east) const {
+  const int64_t r = static_cast<int64_t>(std::floor(north / resolution_));
+  const int64_t c = static_cast<int64_t>(std::floor(east / resolution_));
+  return (r << 32) ^ (c & 0xffffffffLL);
+}
+
+void VisibilityRecord::add_beam(const Vec3& origin, const Vec3& end, bool hit,
+                                double vehicle_altitude) {
+  const Vec3 d = end - origin;
+  const double horizontal = std::hypot(d.x(), d.y());
+  if (!(horizontal > 0) || !std::isfinite(horizontal)) return;
+  // Stop a cell short of a hit: that cell holds the obstacle.
+  const double reach = (hit ? horizontal - resolution_ : horizontal) / horizontal;
+  if (!(reach > 0)) return;
+  // The beam's altitude is linear along it: only the stretch within the
+  // band around the vehicle's altitude counts.
+  const double a0 = -origin.z() - vehicle_altitude, slope = -d.z();
+  double f_lo = 0.0, f_hi = reach;
+  if (std::abs(slope) < 1e-9) {
+    if (std::abs(a0) > band_) return;
+  } else {
+    const double fa = (-band_ - a0) / slope, fb = (band_ - a0) / slope;
+    f_lo = std::max(f_lo, std::min(fa, fb));
+    f_hi = std::min(f_hi, std::max(fa, fb));
+    if (f_hi < f_lo) return;
+  }
+  const double df = 0.5 * resolution_ / horizontal;
+  for (double f = f_lo; f <= f_hi; f += df) {
+    const Vec3 p = origin + f * d;
+    cells_.insert(key(p.x(), p.y()));
+  }
+}
+
+void VisibilityRecord::forget_beyond(const Vec3& centre, double radius) {
+  const double r2 = radius * radius;
+  for (auto it = cells_.begin(); it != cells_.end();) {
+    const int64_t row = *it >> 32;
+    const int32_t col = static_cast<int32_t>(*it & 0xffffffffLL);
+    const double dn = (row + 0.5) * resolution_ - centre.x();
+    const double de = (col + 0.5) * resolution_ - centre.y();
+    it = dn * dn + de * de > r2 ? cells_.erase(it) : std::next(it);
+  }
+}
+
+int cast_occlusion_shadows(mapping::Heightfield& grid, const VisibilityRecord& visibility,
+                           const Vec3& vehicle, double altitude, double depth, double near) {
+  if (grid.empty() || !(depth > 0)) return 0;
+  struct Occluder {
+    int row, col;
+    float top;
+  };
+  // Collected first: shadows cast none of their own.
+  std::vector<Occluder> occluders;
+  for (int r = 0; r < grid.rows; ++r)
+    for (int c = 0; c < grid.cols; ++c)
+      if (grid.at(r, c) > altitude) occluders.push_back({r, c, grid.at(r, c)});
+  const double step = 0.5 * grid.resolution;
+  const int steps = static_cast<int>(std::ceil(depth / step));
+  int raised = 0;
+  for (const auto& o : occluders) {
+    const double north = grid.cell_centre_north(o.row);
+    const double east = grid.cell_centre_east(o.col);
+    const double dn = north - vehicle.x(), de = east - vehicle.y();
+    const double range = std::hypot(dn, de);
+    if (range < near) continue;
+    const double un = dn / range, ue = de / range;
+    for (int k = 1; k <= steps; ++k) {
+      const double n = north + un * step * k, e = east + ue * step * k;
+      if (visibility.seen(n, e)) break;
+      const int r = grid.row_of(n), c = grid.col_of(e);
+      if (!grid.inside(r, c)) break;
+      float& top = grid.at(r, c);
+      if (top < o.top) {
+        top = o.top;
+        ++raised;
+      }
+    }
+  }
+  return raised;
+}
+
+}  // namespace ofn::rh
