@@ -15,35 +15,16 @@
 #include "ofn/common/logging.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/global_planner/global_planner_service.hpp"
+#include "service_test_bus.hpp"
 
 namespace ofn::planning {
 namespace {
 
 constexpr Utime kStart = 10 * kMicrosPerSecond;
-constexpr double kAltitude = 36.6;  // m, 120 ft
+constexpr double kAltitude = 36.576;  // m, 120 ft
 
 mission_t mission() {
-  mission_t m{};
-  m.utime = kStart;
-  m.mission_id = 1;
-  m.name = "wall";
-  m.frame = "NED";
-  m.cruise_speed = 3.048;
-  m.limits.max_speed = 3.048;
-  m.limits.max_accel = 0.48768;
-  m.limits.max_vertical_speed = 1.524;
-  m.limits.min_forward_speed = 0;
-  m.limits.clearance = 6.096;
-  m.limits.sensor_range = 60.96;
-  for (double north : {-30.48, 152.4}) {
-    waypoint_t w{};
-    w.position[0] = north;
-    w.position[2] = -kAltitude;
-    w.capture_radius = 3.0;
-    m.waypoints.push_back(w);
-  }
-  m.num_waypoints = 2;
-  return m;
+  return testing_support::course_mission(kStart);
 }
 
 nav_state_t nav(Utime t, double north) {
@@ -84,42 +65,21 @@ class GlobalPlannerServiceTest : public ::testing::Test {
   static void TearDownTestSuite() { set_log_level("info"); }
 
   GlobalPlannerServiceTest()
-      : lcm_("memq://"),
-        clock_(kStart),
-        service_(lcm_, clock_, config()),
-        bus_("bus", lcm_, clock_) {
-    bus_.subscribe<global_path_t>(channels::kGlobalPath,
-                                  [this](const global_path_t& m) { paths_.push_back(m); });
+      : bus_(kStart),
+        service_(bus_.lcm(), bus_.clock(), config()),
+        listener_("listener", bus_.lcm(), bus_.clock()) {
+    listener_.subscribe<global_path_t>(channels::kGlobalPath,
+                                       [this](const global_path_t& m) { paths_.push_back(m); });
   }
   static GlobalPlannerServiceConfig config() {
     auto reader = YamlReader::empty("(defaults)");
     return load_global_planner_config(reader);
   }
-  void deliver() {
-    while (lcm_.handleTimeout(0) > 0) {
-    }
-  }
-  void advance_to(Utime t) {
-    while (true) {
-      // Timers are scheduled by their first firing.
-      const Utime next = service_.node().next_deadline();
-      if (next == INT64_MIN) {
-        service_.node().fire_due_timers(clock_.now());
-      } else if (next <= t) {
-        clock_.set(std::max(clock_.now(), next));
-        service_.node().fire_due_timers(clock_.now());
-      } else {
-        break;
-      }
-      deliver();
-    }
-    clock_.set(t);
-    deliver();
-  }
+  void deliver() { bus_.deliver(); }
+  void advance_to(Utime t) { bus_.advance_to(service_.node(), t); }
   template <class Msg>
   void send(const std::string& channel, const Msg& m) {
-    lcm_.publish(channel, &m);
-    deliver();
+    bus_.send(channel, m);
   }
   static double highest_altitude(const global_path_t& p) {
     double h = -std::numeric_limits<double>::infinity();
@@ -127,10 +87,9 @@ class GlobalPlannerServiceTest : public ::testing::Test {
     return h;
   }
 
-  lcm::LCM lcm_;
-  ManualClock clock_;
+  testing_support::ServiceTestBus bus_;
   GlobalPlannerService service_;
-  Node bus_;
+  Node listener_;
   std::vector<global_path_t> paths_;
 };
 
@@ -139,8 +98,8 @@ TEST_F(GlobalPlannerServiceTest, NoRouteUntilMissionNavAndCuboidsAreKnown) {
   send(channels::kNavState, nav(kStart, 0));
   advance_to(kStart + 3 * kMicrosPerSecond);
   EXPECT_TRUE(paths_.empty());
-  send(channels::kNavState, nav(clock_.now(), 0));
-  send(channels::kCuboids, wall(clock_.now()));
+  send(channels::kNavState, nav(bus_.now(), 0));
+  send(channels::kCuboids, wall(bus_.now()));
   ASSERT_FALSE(paths_.empty());
 }
 
@@ -170,7 +129,7 @@ TEST_F(GlobalPlannerServiceTest, GoesOverTheWallAndReplansOnChange) {
   EXPECT_LE(paths_.size() - before, 4u);
   // A narrower obstacle whose top was never seen (it reaches the ceiling):
   // the route goes round.
-  const Utime t = clock_.now();
+  const Utime t = bus_.now();
   const size_t published = paths_.size();
   send(channels::kNavState, nav(t, 0.0));
   cuboid_list_t tower = wall(t, false);
@@ -201,7 +160,7 @@ TEST_F(GlobalPlannerServiceTest, BadCuboidsAreRejectedAndCounted) {
   std::swap(inverted.cuboids[0].min_corner[0], inverted.cuboids[0].max_corner[0]);
   send(channels::kCuboids, inverted);
   const std::vector<uint8_t> junk(37, 0xAB);
-  lcm_.publish(channels::kCuboids, junk.data(), static_cast<unsigned>(junk.size()));
+  bus_.lcm().publish(channels::kCuboids, junk.data(), static_cast<unsigned>(junk.size()));
   deliver();
   EXPECT_TRUE(paths_.empty());
   EXPECT_GE(service_.node().counters().rejected, 3);

@@ -16,6 +16,7 @@
 #include "ofn/common/node.hpp"
 #include "ofn/common/validate.hpp"
 #include "ofn/mapper/mapper_service.hpp"
+#include "service_test_bus.hpp"
 
 namespace ofn::mapping {
 namespace {
@@ -45,43 +46,23 @@ class MapperServiceTest : public ::testing::Test {
   static void TearDownTestSuite() { set_log_level("info"); }
 
   MapperServiceTest()
-      : lcm_("memq://"),
-        clock_(kStart),
-        service_(lcm_, clock_, config()),
-        bus_("bus", lcm_, clock_) {
-    bus_.subscribe<obstacle_grid_t>(channels::kObstacleGrid,
-                                    [this](const obstacle_grid_t& m) { grids_.push_back(m); });
-    bus_.subscribe<cuboid_list_t>(channels::kCuboids,
-                                  [this](const cuboid_list_t& m) { cuboids_.push_back(m); });
+      : bus_(kStart),
+        service_(bus_.lcm(), bus_.clock(), config()),
+        listener_("listener", bus_.lcm(), bus_.clock()) {
+    listener_.subscribe<obstacle_grid_t>(channels::kObstacleGrid,
+                                         [this](const obstacle_grid_t& m) { grids_.push_back(m); });
+    listener_.subscribe<cuboid_list_t>(channels::kCuboids,
+                                       [this](const cuboid_list_t& m) { cuboids_.push_back(m); });
   }
   static MapperServiceConfig config() {
     auto reader = YamlReader::empty("(defaults)");
     return load_mapper_config(reader);
   }
-  void deliver() {
-    while (lcm_.handleTimeout(0) > 0) {
-    }
-  }
-  void advance_to(Utime t) {
-    while (true) {
-      const Utime next = service_.node().next_deadline();
-      if (next == INT64_MIN) {
-        service_.node().fire_due_timers(clock_.now());
-      } else if (next <= t) {
-        clock_.set(std::max(clock_.now(), next));
-        service_.node().fire_due_timers(clock_.now());
-      } else {
-        break;
-      }
-      deliver();
-    }
-    clock_.set(t);
-    deliver();
-  }
+  void deliver() { bus_.deliver(); }
+  void advance_to(Utime t) { bus_.advance_to(service_.node(), t); }
   template <class Msg>
   void send(const std::string& channel, const Msg& m) {
-    lcm_.publish(channel, &m);
-    deliver();
+    bus_.send(channel, m);
   }
   /// A scan fed over several cycles until the wall is confirmed.
   void map_wall(Utime from, int scans) {
@@ -92,10 +73,9 @@ class MapperServiceTest : public ::testing::Test {
     }
   }
 
-  lcm::LCM lcm_;
-  ManualClock clock_;
+  testing_support::ServiceTestBus bus_;
   MapperService service_;
-  Node bus_;
+  Node listener_;
   std::vector<obstacle_grid_t> grids_;
   std::vector<cuboid_list_t> cuboids_;
 };
@@ -124,23 +104,23 @@ TEST_F(MapperServiceTest, BadScansAreRejectedCountedAndTheMapperKeepsRunning) {
   const size_t grids_before = grids_.size();
   const int64_t rejected_before = service_.node().counters().rejected;
 
-  scan_world_t nan_scan = wall_scan(clock_.now() + 1000);
+  scan_world_t nan_scan = wall_scan(bus_.now() + 1000);
   nan_scan.points[3][1] = std::numeric_limits<float>::quiet_NaN();
   send(channels::kScanWorld, nan_scan);
 
-  scan_world_t old_scan = wall_scan(clock_.now() - 200000);  // older than the last one
+  scan_world_t old_scan = wall_scan(bus_.now() - 200000);  // older than the last one
   send(channels::kScanWorld, old_scan);
 
-  scan_world_t huge = wall_scan(clock_.now() + 2000);
+  scan_world_t huge = wall_scan(bus_.now() + 2000);
   huge.points.resize(MessageLimits::kMaxScanPoints + 1, {1.0f, 1.0f, -1.0f});
   huge.num_points = static_cast<int32_t>(huge.points.size());
   send(channels::kScanWorld, huge);
 
-  scan_world_t wrong_frame = wall_scan(clock_.now() + 3000);
+  scan_world_t wrong_frame = wall_scan(bus_.now() + 3000);
   wrong_frame.frame = "ENU";
   send(channels::kScanWorld, wrong_frame);
 
-  scan_world_t stale = wall_scan(clock_.now() - 5 * kMicrosPerSecond);
+  scan_world_t stale = wall_scan(bus_.now() - 5 * kMicrosPerSecond);
   send(channels::kScanWorld, stale);
 
   EXPECT_EQ(grids_.size(), grids_before) << "a bad scan changed the map";
@@ -148,8 +128,8 @@ TEST_F(MapperServiceTest, BadScansAreRejectedCountedAndTheMapperKeepsRunning) {
   EXPECT_EQ(service_.scans_dropped_out_of_order(), 1);
 
   // A good scan afterwards is mapped as usual.
-  advance_to(clock_.now() + 80000);
-  send(channels::kScanWorld, wall_scan(clock_.now()));
+  advance_to(bus_.now() + 80000);
+  send(channels::kScanWorld, wall_scan(bus_.now()));
   EXPECT_EQ(grids_.size(), grids_before + 1);
 }
 

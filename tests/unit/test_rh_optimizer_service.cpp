@@ -15,36 +15,17 @@
 #include "ofn/common/logging.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/rh_optimizer/rh_optimizer_service.hpp"
+#include "service_test_bus.hpp"
 
 namespace ofn::rh {
 namespace {
 
 constexpr Utime kStart = 10 * kMicrosPerSecond;
-constexpr double kAltitude = 36.6;  // m, 120 ft
-constexpr double kSpeed = 3.048;    // m/s, 10 ft/s
+constexpr double kAltitude = 36.576;  // m, 120 ft
+constexpr double kSpeed = 3.048;      // m/s, 10 ft/s
 
 mission_t mission() {
-  mission_t m{};
-  m.utime = kStart;
-  m.mission_id = 1;
-  m.name = "wall";
-  m.frame = "NED";
-  m.cruise_speed = kSpeed;
-  m.limits.max_speed = kSpeed;
-  m.limits.max_accel = 0.48768;
-  m.limits.max_vertical_speed = 1.524;
-  m.limits.min_forward_speed = 0;
-  m.limits.clearance = 6.096;
-  m.limits.sensor_range = 60.96;
-  for (double north : {-30.48, 152.4}) {
-    waypoint_t w{};
-    w.position[0] = north;
-    w.position[2] = -kAltitude;
-    w.capture_radius = 3.0;
-    m.waypoints.push_back(w);
-  }
-  m.num_waypoints = 2;
-  return m;
+  return testing_support::course_mission(kStart);
 }
 
 nav_state_t nav(Utime t, const Vec3& position, const Vec3& velocity = Vec3(kSpeed, 0, 0)) {
@@ -111,59 +92,37 @@ class RhOptimizerServiceTest : public ::testing::Test {
   static void TearDownTestSuite() { set_log_level("info"); }
 
   RhOptimizerServiceTest()
-      : lcm_("memq://"),
-        clock_(kStart),
-        service_(lcm_, clock_, config()),
-        bus_("bus", lcm_, clock_) {
-    bus_.subscribe<ref_traj_t>(channels::kRefTraj,
-                               [this](const ref_traj_t& m) { trajs_.push_back(m); });
-    bus_.subscribe<solver_stats_t>(channels::kSolverStats,
-                                   [this](const solver_stats_t& m) { stats_.push_back(m); });
+      : bus_(kStart),
+        service_(bus_.lcm(), bus_.clock(), config()),
+        listener_("listener", bus_.lcm(), bus_.clock()) {
+    listener_.subscribe<ref_traj_t>(channels::kRefTraj,
+                                    [this](const ref_traj_t& m) { trajs_.push_back(m); });
+    listener_.subscribe<solver_stats_t>(channels::kSolverStats,
+                                        [this](const solver_stats_t& m) { stats_.push_back(m); });
   }
   static RhOptimizerServiceConfig config() {
     auto reader = YamlReader::empty("(defaults)");
     return load_rh_optimizer_config(reader);
   }
-  void deliver() {
-    while (lcm_.handleTimeout(0) > 0) {
-    }
-  }
-  /// Moves the clock to t, firing the optimiser's ticks on the way.
-  void advance_to(Utime t) {
-    while (true) {
-      const Utime next = service_.node().next_deadline();
-      if (next == INT64_MIN) {
-        service_.node().fire_due_timers(clock_.now());
-      } else if (next <= t) {
-        clock_.set(std::max(clock_.now(), next));
-        service_.node().fire_due_timers(clock_.now());
-      } else {
-        break;
-      }
-      deliver();
-    }
-    clock_.set(t);
-    deliver();
-  }
+  void deliver() { bus_.deliver(); }
+  void advance_to(Utime t) { bus_.advance_to(service_.node(), t); }
   template <class Msg>
   void send(const std::string& channel, const Msg& m) {
-    lcm_.publish(channel, &m);
-    deliver();
+    bus_.send(channel, m);
   }
   /// One 0.1 s step with fresh nav and grid just before the tick.
   void step(const Vec3& position, double wall_north, double wall_top,
             const Vec3& velocity = Vec3(kSpeed, 0, 0)) {
-    const Utime t = clock_.now() + 50000;
+    const Utime t = bus_.now() + 50000;
     advance_to(t);
     send(channels::kNavState, nav(t, position, velocity));
     send(channels::kObstacleGrid, grid(t, wall_north, wall_top));
     advance_to(t + 50000);
   }
 
-  lcm::LCM lcm_;
-  ManualClock clock_;
+  testing_support::ServiceTestBus bus_;
   RhOptimizerService service_;
-  Node bus_;
+  Node listener_;
   std::vector<ref_traj_t> trajs_;
   std::vector<solver_stats_t> stats_;
 };
@@ -179,7 +138,7 @@ TEST_F(RhOptimizerServiceTest, ClearWayAheadLeavesNominalGuidanceAlone) {
 
 TEST_F(RhOptimizerServiceTest, AWallAheadEngagesAvoidanceOverIt) {
   send(channels::kMission, mission());
-  send(channels::kGlobalPath, route_over(clock_.now()));
+  send(channels::kGlobalPath, route_over(bus_.now()));
   for (int i = 0; i < 5; ++i) step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
   ASSERT_TRUE(service_.engaged());
   ASSERT_FALSE(trajs_.empty());
@@ -215,18 +174,18 @@ TEST_F(RhOptimizerServiceTest, BadInputIsRejectedCountedAndSurvived) {
   send(channels::kMission, mission());
   step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
   const int64_t before = service_.node().counters().rejected;
-  obstacle_grid_t nan_grid = grid(clock_.now(), 45.0, 42.7);
+  obstacle_grid_t nan_grid = grid(bus_.now(), 45.0, 42.7);
   nan_grid.top_altitude[5] = std::numeric_limits<float>::quiet_NaN();
   send(channels::kObstacleGrid, nan_grid);
-  obstacle_grid_t wrong = grid(clock_.now(), 45.0, 42.7);
+  obstacle_grid_t wrong = grid(bus_.now(), 45.0, 42.7);
   wrong.rows = 7;  // rows * cols != cells
   wrong.num_cells = 7 * wrong.cols;
   wrong.top_altitude.resize(wrong.num_cells);
   wrong.rows = 8;
   send(channels::kObstacleGrid, wrong);
-  send(channels::kNavState, nav(clock_.now(), Vec3(std::nan(""), 0, 0)));
+  send(channels::kNavState, nav(bus_.now(), Vec3(std::nan(""), 0, 0)));
   global_path_t path{};
-  path.utime = clock_.now();
+  path.utime = bus_.now();
   path.frame = "ENU";
   send(channels::kGlobalPath, path);
   EXPECT_GE(service_.node().counters().rejected - before, 4);
