@@ -2,14 +2,12 @@
 
 #include "ofn/actuator_cmd_t.hpp"
 #include "ofn/common/channels.hpp"
+#include "ofn/common/mission_plan.hpp"
 #include "ofn/control_status_t.hpp"
 
 namespace ofn::control {
 namespace {
 
-Vec3 vec(const double (&a)[3]) {
-  return Vec3(a[0], a[1], a[2]);
-}
 Vec3 vec(const std::vector<double>& a) {
   return Vec3(a[0], a[1], a[2]);
 }
@@ -144,7 +142,7 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
 
 void ControllerService::on_mission(const mission_t& m) {
   // The uplink repeats the plan; only a new id is a new plan.
-  if (mission_ && mission_->mission_id == m.mission_id && mission_->name == m.name) return;
+  if (mission_ && same_plan(*mission_, m)) return;
   mission_ = m;
   mission_pending_ = true;
   node_.log().info("mission {} '{}': {} waypoints, cruise {:.2f} m/s", m.mission_id, m.name,
@@ -215,24 +213,20 @@ void ControllerService::control_step() {
   }
   node_.set_state("running");
   VehicleEstimate x;
-  x.position = vec(nav_->position);
-  x.velocity = vec(nav_->velocity);
+  x.position = to_vec3(nav_->position);
+  x.velocity = to_vec3(nav_->velocity);
   x.attitude =
       Quat(nav_->quaternion[0], nav_->quaternion[1], nav_->quaternion[2], nav_->quaternion[3])
           .normalized();
-  x.body_rates = vec(nav_->body_rates);
+  x.body_rates = to_vec3(nav_->body_rates);
   if (!path_yaw_set_) {
     path_yaw_ = nav_->euler[2];
     path_yaw_set_ = true;
   }
 
   if (mission_pending_) {
-    std::vector<Waypoint> wps;
-    for (const auto& w : mission_->waypoints) wps.push_back({vec(w.position), w.capture_radius});
-    Limits lim{mission_->limits.max_speed,          mission_->limits.max_accel,
-               mission_->limits.max_vertical_speed, mission_->limits.min_forward_speed,
-               mission_->limits.clearance,          mission_->limits.sensor_range};
-    guidance_.set_mission(wps, mission_->cruise_speed, lim, x.position, x.velocity);
+    guidance_.set_mission(waypoints_from(*mission_), mission_->cruise_speed,
+                          limits_from(mission_->limits), x.position, x.velocity);
     mission_pending_ = false;
   }
 
@@ -290,7 +284,7 @@ void ControllerService::publish_status() {
   put(s.ref_acceleration, last_ref_.acceleration);
   put(s.commanded_acceleration, last_out_.commanded_accel);
   put(s.adaptive_output, last_out_.adaptive_accel);
-  const Vec3 pos = nav_ ? vec(nav_->position) : last_ref_.position;
+  const Vec3 pos = nav_ ? to_vec3(nav_->position) : last_ref_.position;
   put(s.position_error, last_ref_.position - pos);
   s.yaw_reference = last_ref_.yaw;
   s.ref_traj_fresh = mode_ == control_status_t::TRAJECTORY;

@@ -5,17 +5,6 @@
 #include <limits>
 
 namespace ofn::control {
-namespace {
-
-double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
-}  // namespace
-
 void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, double cruise_speed,
                                    const Limits& limits, const Vec3& position,
                                    const Vec3& velocity) {
@@ -24,18 +13,7 @@ void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, doubl
   limits_ = limits;
   done_ = false;
   if (waypoints_.empty()) return;
-  int best = 0;
-  if (waypoints_.size() > 1) {
-    double best_distance = std::numeric_limits<double>::infinity();
-    for (size_t i = 1; i < waypoints_.size(); ++i) {
-      const double d =
-          distance_to_segment(position, waypoints_[i - 1].position, waypoints_[i].position);
-      if (d <= best_distance) {  // ties go to the later leg
-        best_distance = d;
-        best = static_cast<int>(i);
-      }
-    }
-  }
+  const int best = nearest_leg(waypoints_, position);
   // Start the leg at the vehicle's projection onto it, so the reference
   // does not jump.
   const Vec3 from = best > 0 ? waypoints_[best - 1].position : position;

@@ -9,10 +9,6 @@
 namespace ofn::planning {
 namespace {
 
-Vec3 vec(const double v[3]) {
-  return Vec3(v[0], v[1], v[2]);
-}
-
 int8_t status_code(PlanStatus s) {
   switch (s) {
     case PlanStatus::kOk:
@@ -85,7 +81,7 @@ std::vector<ObstacleBox> boxes_from(const cuboid_list_t& msg) {
   std::vector<ObstacleBox> boxes;
   boxes.reserve(msg.cuboids.size());
   for (const auto& c : msg.cuboids)
-    boxes.push_back({c.id, vec(c.min_corner), vec(c.max_corner), c.top_observed != 0});
+    boxes.push_back({c.id, to_vec3(c.min_corner), to_vec3(c.max_corner), c.top_observed != 0});
   return boxes;
 }
 
@@ -126,7 +122,7 @@ GlobalPlannerService::GlobalPlannerService(lcm::LCM& lcm, const Clock& clock,
 void GlobalPlannerService::on_nav(const nav_state_t& m) {
   nav_ = m;
   if (!legs_.has_plan()) return;
-  const auto leg = legs_.update(vec(m.position));
+  const auto leg = legs_.update(to_vec3(m.position));
   if (leg && leg->index != active_leg_) {
     active_leg_ = leg->index;
     replan("new target waypoint");
@@ -135,7 +131,7 @@ void GlobalPlannerService::on_nav(const nav_state_t& m) {
 
 void GlobalPlannerService::on_mission(const mission_t& m) {
   // The uplink repeats the plan; only a new id is a new plan.
-  if (mission_ && mission_->mission_id == m.mission_id && mission_->name == m.name) return;
+  if (mission_ && same_plan(*mission_, m)) return;
   if (m.waypoints.empty()) {
     node_.reject(channels::kMission, "no waypoints");
     return;
@@ -170,7 +166,7 @@ void GlobalPlannerService::replan(const char* why) {
     node_.set_state("cuboids stale");
     return;
   }
-  const Vec3 position = vec(nav_->position);
+  const Vec3 position = to_vec3(nav_->position);
   if (!legs_.has_plan()) legs_.set_plan(waypoints_from(*mission_), position);
   const auto leg = legs_.update(position);
   if (!leg) return;
@@ -178,7 +174,7 @@ void GlobalPlannerService::replan(const char* why) {
 
   PlanRequest request;
   request.start = position;
-  request.start_velocity = vec(nav_->velocity);
+  request.start_velocity = to_vec3(nav_->velocity);
   request.goal = leg->to;
   request.leg_from = leg->from;
   request.obstacles = boxes_from(*cuboids_);

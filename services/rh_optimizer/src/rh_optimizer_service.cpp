@@ -9,10 +9,6 @@
 namespace ofn::rh {
 namespace {
 
-Vec3 vec(const double v[3]) {
-  return Vec3(v[0], v[1], v[2]);
-}
-
 Vec3 vec3_in(YamlReader& r, const std::string& key, const Vec3& fallback, double lo, double hi) {
   const std::vector<double> v = r.numbers(key, {fallback.x(), fallback.y(), fallback.z()});
   if (v.size() != 3) r.fail(key, "expected three numbers [x, y, z]");
@@ -217,7 +213,7 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
 }
 
 void RhOptimizerService::on_mission(const mission_t& m) {
-  if (mission_ && mission_->mission_id == m.mission_id && mission_->name == m.name) return;
+  if (mission_ && same_plan(*mission_, m)) return;
   if (m.waypoints.empty()) {
     node_.reject(channels::kMission, "no waypoints");
     return;
@@ -250,7 +246,7 @@ void RhOptimizerService::on_global_path(const global_path_t& m) {
   std::vector<Vec3> points;
   points.reserve(m.points.size());
   for (const auto& p : m.points) points.emplace_back(p[0], p[1], p[2]);
-  const Vec3 from = nav_ ? vec(nav_->position) : points.front();
+  const Vec3 from = nav_ ? to_vec3(nav_->position) : points.front();
   const double horizon = mission_ ? mission_->limits.sensor_range : 60.0;
   // The planner re-publishes every second; only a different way round is a
   // new route (and a reason to drop the warm start).
@@ -264,7 +260,7 @@ void RhOptimizerService::on_global_path(const global_path_t& m) {
 }
 
 void RhOptimizerService::on_scan(const scan_world_t& m) {
-  const Vec3 origin = vec(m.sensor_origin);
+  const Vec3 origin = to_vec3(m.sensor_origin);
   const double altitude = -origin.z();
   for (const auto& p : m.points)
     visibility_.add_beam(origin, Vec3(p[0], p[1], p[2]), true, altitude);
@@ -350,8 +346,8 @@ void RhOptimizerService::tick() {
     note("nav stale");
     return publish_stats(now, solver_stats_t::NOT_RUN, "nav stale", nullptr);
   }
-  const Vec3 position = vec(nav_->position);
-  const Vec3 velocity = vec(nav_->velocity);
+  const Vec3 position = to_vec3(nav_->position);
+  const Vec3 velocity = to_vec3(nav_->velocity);
   if (!legs_.has_plan()) legs_.set_plan(waypoints_from(*mission_), position);
   const auto active = legs_.update(position);
   if (!active) return note("no leg");
@@ -408,7 +404,7 @@ void RhOptimizerService::tick() {
         p.acceleration = last_trajectory_.acceleration(since);
     }
   } else {
-    p.acceleration = vec(nav_->acceleration);
+    p.acceleration = to_vec3(nav_->acceleration);
     const double norm = p.acceleration.norm();
     if (norm > mission_->limits.max_accel) p.acceleration *= mission_->limits.max_accel / norm;
   }

@@ -14,6 +14,7 @@
 #include "ofn/actuator_cmd_t.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
+#include "ofn/common/mission_plan.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/cuboid_list_t.hpp"
 #include "ofn/global_path_t.hpp"
@@ -27,10 +28,6 @@
 
 namespace ofn::report {
 namespace {
-
-Vec3 vec(const double (&a)[3]) {
-  return Vec3(a[0], a[1], a[2]);
-}
 
 /// The q-quantile (0..1, nearest rank) of the values; none when empty.
 std::optional<double> percentile(std::vector<double> values, double q) {
@@ -131,11 +128,11 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       if (!decode(e, m)) return false;
       NavSample s;
       s.t = rel(m.utime);
-      s.position = vec(m.position);
-      s.velocity = vec(m.velocity);
-      s.acceleration = vec(m.acceleration);
-      s.euler = vec(m.euler);
-      s.body_rates = vec(m.body_rates);
+      s.position = to_vec3(m.position);
+      s.velocity = to_vec3(m.velocity);
+      s.acceleration = to_vec3(m.acceleration);
+      s.euler = to_vec3(m.euler);
+      s.body_rates = to_vec3(m.body_rates);
       nav.push_back(s);
       nav_csv << s.t;
       row(nav_csv, {s.position, s.velocity, s.acceleration, s.euler, s.body_rates});
@@ -148,11 +145,11 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       s.mode = m.mode;
       s.mission_id = m.mission_id;
       s.active_waypoint = m.active_waypoint;
-      s.ref_position = vec(m.ref_position);
-      s.ref_velocity = vec(m.ref_velocity);
-      s.ref_acceleration = vec(m.ref_acceleration);
-      s.commanded_accel = vec(m.commanded_acceleration);
-      s.position_error = vec(m.position_error);
+      s.ref_position = to_vec3(m.ref_position);
+      s.ref_velocity = to_vec3(m.ref_velocity);
+      s.ref_acceleration = to_vec3(m.ref_acceleration);
+      s.commanded_accel = to_vec3(m.commanded_acceleration);
+      s.position_error = to_vec3(m.position_error);
       s.yaw_reference = m.yaw_reference;
       status.push_back(s);
       status_csv << s.t << "," << s.mode << "," << s.mission_id << "," << s.active_waypoint;
@@ -244,9 +241,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
 
   Limits limits;
   if (mission) {
-    limits = {mission->limits.max_speed,          mission->limits.max_accel,
-              mission->limits.max_vertical_speed, mission->limits.min_forward_speed,
-              mission->limits.clearance,          mission->limits.sensor_range};
+    limits = limits_from(mission->limits);
     auto wp_csv = open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
     for (size_t i = 0; i < mission->waypoints.size(); ++i) {
       const auto& w = mission->waypoints[i];

@@ -50,6 +50,19 @@ inline Vec3 euler_from_quat(const Quat& q) {
 
 /// Course frame (x along the course, y right, h up) to NED, both in metres.
 /// The benchmarks lay the course along north.
+/// A fixed-size array of three numbers (as in LCM messages) as a vector.
+inline Vec3 to_vec3(const double (&a)[3]) {
+  return Vec3(a[0], a[1], a[2]);
+}
+
+/// Distance from p to the segment a-b (to a when the segment is a point).
+inline double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
 inline Vec3 course_to_ned(const Vec3& course) {
   return Vec3(course.x(), course.y(), -course.z());
 }

@@ -17,11 +17,15 @@
 
 namespace ofn {
 
+/// The uplink repeats the plan; only a new id (or scenario) is a new plan.
+inline bool same_plan(const mission_t& a, const mission_t& b) {
+  return a.mission_id == b.mission_id && a.name == b.name;
+}
+
 /// The message must have passed validate(mission_t).
 inline std::vector<Waypoint> waypoints_from(const mission_t& m) {
   std::vector<Waypoint> out;
-  for (const auto& w : m.waypoints)
-    out.push_back({Vec3(w.position[0], w.position[1], w.position[2]), w.capture_radius});
+  for (const auto& w : m.waypoints) out.push_back({to_vec3(w.position), w.capture_radius});
   return out;
 }
 
@@ -42,22 +46,8 @@ class LegTracker {
   /// Starts a plan at the leg nearest `position` (ties go to the later leg).
   void set_plan(std::vector<Waypoint> waypoints, const Vec3& position) {
     waypoints_ = std::move(waypoints);
-    active_ = -1;
-    if (waypoints_.empty()) return;
-    if (waypoints_.size() == 1) {
-      active_ = 0;
-      single_from_ = position;
-      return;
-    }
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t i = 1; i < waypoints_.size(); ++i) {
-      const double d =
-          distance_to_segment(position, waypoints_[i - 1].position, waypoints_[i].position);
-      if (d <= best) {
-        best = d;
-        active_ = static_cast<int>(i);
-      }
-    }
+    active_ = nearest_leg(waypoints_, position);
+    single_from_ = position;  // where a single-waypoint plan's leg starts
   }
 
   void clear() {
@@ -79,13 +69,6 @@ class LegTracker {
   }
 
  private:
-  static double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
-    const Vec3 ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    return (a + t * ab - p).norm();
-  }
-
   bool reached(const Vec3& position) const {
     const Waypoint& target = waypoints_[active_];
     if ((position - target.position).norm() <= target.capture_radius) return true;

@@ -4,6 +4,7 @@
 // to SI and world NED on load. See docs/SCENARIO_FORMAT.md.
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,24 @@ struct Waypoint {
   Vec3 position = Vec3::Zero();  // m, world NED
   double capture_radius = 0;     // m
 };
+
+/// Index of the waypoint that ends the leg nearest `position` (ties go to
+/// the later leg); 0 for a single waypoint, -1 for none. Where a plan is
+/// picked up mid-route (a restarted controller, the planners).
+inline int nearest_leg(const std::vector<Waypoint>& waypoints, const Vec3& position) {
+  if (waypoints.empty()) return -1;
+  int best = 0;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (size_t i = 1; i < waypoints.size(); ++i) {
+    const double d =
+        distance_to_segment(position, waypoints[i - 1].position, waypoints[i].position);
+    if (d <= best_distance) {
+      best_distance = d;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
 
 /// The airframe as flown, relative to the model the controller assumes
 /// (vehicle_sim's configured airframe), and its actuator authority. The
