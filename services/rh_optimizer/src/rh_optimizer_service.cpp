@@ -44,12 +44,8 @@ int8_t traj_mode(StepMode mode) {
 double distance_to_polyline(const std::vector<Vec3>& line, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
   if (line.size() == 1) return (line[0] - p).norm();
-  for (size_t i = 1; i < line.size(); ++i) {
-    const Vec3 ab = line[i] - line[i - 1];
-    const double len2 = ab.squaredNorm();
-    const double t = len2 > 0 ? std::clamp((p - line[i - 1]).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (line[i - 1] + t * ab - p).norm());
-  }
+  for (size_t i = 1; i < line.size(); ++i)
+    best = std::min(best, distance_to_segment(p, line[i - 1], line[i]));
   return best;
 }
 
