@@ -70,6 +70,7 @@ ControllerConfig load_controller_config(YamlReader& r) {
     net->output_rate = n.number_in("output_rate", net->output_rate, 0.0, 1e4);
     net->hidden_rate = n.number_in("hidden_rate", net->hidden_rate, 0.0, 1e4);
     net->e_modification = n.number_in("e_modification", net->e_modification, 0.0, 100.0);
+    net->dead_zone = n.number_in("dead_zone", net->dead_zone, 0.0, 100.0);
     net->max_weight_norm = n.number_in("max_weight_norm", net->max_weight_norm, 0.1, 1e4);
     net->max_output = n.number_in("max_output", net->max_output, 0.0, 1e3);
     n.finish();

@@ -75,6 +75,11 @@ Eigen::VectorXd NeuralNetwork::evaluate(const Eigen::VectorXd& inputs) {
 
 void NeuralNetwork::update(const Eigen::VectorXd& error_signal, double error_norm, double dt) {
   if (!error_signal.allFinite() || !std::isfinite(error_norm) || !(dt > 0)) return;
+  // Dead zone, ramped so that learning does not switch on with a jolt.
+  double learning = 1.0;
+  if (settings_.dead_zone > 0.0)
+    learning = std::clamp(error_norm / settings_.dead_zone - 1.0, 0.0, 1.0);
+  if (learning == 0.0) return;
   const Eigen::VectorXd r = error_signal.cwiseMax(-kErrorClip).cwiseMin(kErrorClip);
   const double leak = settings_.e_modification * std::min(error_norm, kErrorClip);
   // sigma_bar - sigma_bar' V^T x_bar: the bias row has no slope.
@@ -82,8 +87,10 @@ void NeuralNetwork::update(const Eigen::VectorXd& error_signal, double error_nor
   linearised.tail(z_.size()) -= sigma_slope_.cwiseProduct(z_);
   // r^T W^T sigma_bar' (a row over the hidden neurons).
   const Eigen::VectorXd back = (w_ * r).tail(z_.size()).cwiseProduct(sigma_slope_);
-  const Eigen::MatrixXd w_dot = -settings_.output_rate * (linearised * r.transpose() + leak * w_);
-  const Eigen::MatrixXd v_dot = -settings_.hidden_rate * (x_bar_ * back.transpose() + leak * v_);
+  const Eigen::MatrixXd w_dot =
+      -learning * settings_.output_rate * (linearised * r.transpose() + leak * w_);
+  const Eigen::MatrixXd v_dot =
+      -learning * settings_.hidden_rate * (x_bar_ * back.transpose() + leak * v_);
   w_ += dt * w_dot;
   v_ += dt * v_dot;
   bound_norm(w_, settings_.max_weight_norm);

@@ -23,12 +23,16 @@ struct NetworkSettings {
   double e_modification = 0.5;    // kappa: leakage proportional to the error norm
   double max_weight_norm = 20.0;  // projection bound on each layer's Frobenius norm
   double max_output = 5.0;        // bound on each output component
+  // Error norm below which the weights stay put, with full learning from
+  // twice this: without it the network keeps chasing sensor noise and
+  // the yaw sweep, and its output shakes a well-modelled airframe.
+  double dead_zone = 0.0;
 };
 
 struct AdaptiveConfig {
   bool enabled = true;  // false: the non-adaptive baseline (reference models and hedging stay)
-  NetworkSettings outer{8, 4.0, 1.0, 0.05, 20.0, 5.0};       // outputs m/s^2
-  NetworkSettings inner{8, 100.0, 20.0, 0.005, 50.0, 20.0};  // outputs rad/s^2
+  NetworkSettings outer{8, 4.0, 1.0, 0.05, 20.0, 5.0, 0.25};       // outputs m/s^2
+  NetworkSettings inner{8, 100.0, 20.0, 0.005, 50.0, 20.0, 0.02};  // outputs rad/s^2
   uint32_t seed = 7;                                         // initial hidden-layer weights
 };
 
