@@ -281,6 +281,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   const auto finish_gate = scenario ? scenario->finish_gate : std::nullopt;
   result.summary = analyse_flight(nav, status, limits, start_gate, finish_gate);
   const FlightSummary& s = result.summary;
+  result.verdict = judge_flight(s, limits, min_clearance, finish_gate.has_value());
 
   const std::string unit = scenario ? scenario->display_unit : "m";
   const double k = scenario ? scenario->metres_per_unit : 1.0;
@@ -305,6 +306,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"duration\": " << s.duration << ",\n"
        << "  \"max_speed\": " << s.max_speed << ",\n"
        << "  \"max_vertical_speed\": " << s.max_vertical_speed << ",\n"
+       << "  \"min_forward_speed\": " << s.min_forward_speed << ",\n"
        << "  \"max_commanded_accel\": " << s.max_commanded_accel << ",\n"
        << "  \"max_commanded_accel_fraction\": " << s.max_commanded_accel_fraction << ",\n"
        << "  \"max_pseudo_control\": " << s.max_pseudo_control << ",\n"
@@ -320,6 +322,11 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"rh_kept_previous\": " << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ",\n"
        << "  \"rh_braking\": " << solver_status_count[solver_stats_t::BRAKING] << ",\n"
        << "  \"rh_deferred\": " << solver_status_count[solver_stats_t::DEFERRED] << ",\n"
+       << "  \"success\": " << (result.verdict.success ? "true" : "false") << ",\n"
+       << "  \"failures\": [";
+  for (size_t i = 0; i < result.verdict.failures.size(); ++i)
+    json << (i ? ", " : "") << "\"" << result.verdict.failures[i] << "\"";
+  json << "],\n"
        << "  \"obstacles\": [";
   if (scenario) {
     // Metres, like every other length in this file (the plot scales them).
@@ -344,6 +351,10 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     << (s.reached_last_waypoint ? "reached the last waypoint" : "did NOT reach the last waypoint");
   if (finish_gate)
     t << (s.crossed_finish ? ", crossed the finish gate" : ", did NOT cross the finish gate");
+  t << "\n";
+  t << "  verdict           : "
+    << (result.verdict.success ? "success (gate, 0.8 R_s clearance, limits within 2 %)" : "FAILED");
+  for (const auto& f : result.verdict.failures) t << "\n                      " << f;
   t << "\n";
   if (s.gate_to_gate)
     t << "  gate-to-gate time : " << *s.gate_to_gate << " s (x = " << *start_gate / k << " -> "

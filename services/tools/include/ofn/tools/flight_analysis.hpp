@@ -33,6 +33,9 @@ struct FlightSummary {
   std::optional<double> gate_to_gate;                       // s
   double max_speed = 0;                                     // m/s, whole flight
   double max_vertical_speed = 0;                            // m/s
+  /// m/s, least velocity along the course (north) between the gates; the
+  /// limits ask for >= 0. Zero without both gates.
+  double min_forward_speed = 0;
   /// m/s^2, largest |acceleration| the trajectory source (waypoint guidance
   /// or the RH optimiser) commanded while the plan was flown: the quantity
   /// the planners' acceleration limit applies to (paper Eq. 8).
@@ -44,6 +47,22 @@ struct FlightSummary {
   double tracking_rms = 0;  // m, |reference - actual| while flying the plan
   double tracking_max = 0;  // m
 };
+
+/// The benchmark rule (../shared/BENCHMARKS.md, "What a run reports"): a
+/// run fails if it misses the finish gate, comes closer than 0.8 R_s to a
+/// real surface, or leaves a limit by more than 2 %.
+struct Verdict {
+  bool success = false;
+  std::vector<std::string> failures;  // one line per broken rule, empty on success
+};
+constexpr double kLimitTolerance = 0.02;     // share by which a limit may be exceeded
+constexpr double kClearanceFailShare = 0.8;  // of R_s
+
+/// `min_clearance` is the least true clearance (none: no obstacles);
+/// `has_finish_gate` false judges a flight without gates by its limits and
+/// clearance alone.
+Verdict judge_flight(const FlightSummary& s, const Limits& limits,
+                     std::optional<double> min_clearance, bool has_finish_gate);
 
 /// Time at which the north coordinate first reaches `x` (linear
 /// interpolation between samples), or nullopt.

@@ -19,6 +19,7 @@ struct ReportResult {
   /// Least distance from the flown path to a real obstacle (m); none
   /// without a scenario or obstacles.
   std::optional<double> min_clearance;
+  Verdict verdict;  // the benchmark rule applied to this flight
 };
 
 /// Reads `log_path`, writes CSV and summary files into `out_dir` (created if
