@@ -79,6 +79,8 @@ ControllerConfig load_controller_config(YamlReader& r) {
   YamlReader guidance = r.child("guidance");
   c.guidance.accel_fraction =
       guidance.number_in("accel_fraction", c.guidance.accel_fraction, 0.05, 1.0);
+  c.guidance.speed_fraction =
+      guidance.number_in("speed_fraction", c.guidance.speed_fraction, 0.5, 1.0);
   c.guidance.speed_gain = guidance.number_in("speed_gain", c.guidance.speed_gain, 0.05, 20.0);
   c.guidance.jerk_fraction =
       guidance.number_in("jerk_fraction", c.guidance.jerk_fraction, 0.05, 100.0);

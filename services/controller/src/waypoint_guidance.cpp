@@ -9,7 +9,11 @@ void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, doubl
                                    const Limits& limits, const Vec3& position,
                                    const Vec3& velocity) {
   waypoints_ = waypoints;
-  cruise_speed_ = cruise_speed;
+  // The cruise may not use the whole speed limit: the controller tracks to
+  // a few per cent (the yaw sweep shakes the speed), and the limit is hard.
+  cruise_speed_ = limits.max_speed > 0
+                      ? std::min(cruise_speed, config_.speed_fraction * limits.max_speed)
+                      : cruise_speed;
   limits_ = limits;
   done_ = false;
   if (waypoints_.empty()) return;

@@ -57,7 +57,7 @@ struct ControllerGains {
   // Reference models: second order, natural frequency and damping per loop.
   double outer_reference_frequency = 1.0;  // rad/s
   double outer_reference_damping = 1.0;
-  double inner_reference_frequency = 5.0;  // rad/s
+  double inner_reference_frequency = 8.0;  // rad/s
   double inner_reference_damping = 1.0;
   // Pseudo-control hedging: off only to show what it prevents.
   bool hedging = true;
