@@ -146,9 +146,10 @@ TEST_F(RhOptimizerServiceTest, AWallAheadEngagesAvoidanceOverIt) {
   EXPECT_EQ(t.mode, ref_traj_t::AVOIDANCE);
   EXPECT_GE(t.num_samples, 2);
   EXPECT_GT(t.num_control_points, 0);
-  // It starts where the vehicle is and climbs above the wall top plus the
+  // It starts on the last plan (the vehicle, held still here, is within
+  // replan_position_error of it) and climbs above the wall top plus the
   // clearance by the time it is over the wall.
-  EXPECT_NEAR(t.position.front()[0], 0.0, 0.5);
+  EXPECT_NEAR(t.position.front()[0], 0.0, 3.0);
   double altitude_over_wall = 0;
   for (size_t i = 0; i < t.position.size(); ++i)
     if (t.position[i][0] >= 45.0 && t.position[i][0] <= 48.0)

@@ -1,15 +1,32 @@
 #include "ofn/rh_optimizer/occlusion.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <utility>
 #include <vector>
 
 namespace ofn::rh {
+namespace {
+
+int64_t cell_key(double north, double east, double resolution) {
+  const int64_t r = static_cast<int64_t>(std::floor(north / resolution));
+  const int64_t c = static_cast<int64_t>(std::floor(east / resolution));
+  return (r << 32) ^ (c & 0xffffffffLL);
+}
+
+// Centre (north, east) of the cell a key names.
+std::pair<double, double> key_centre(int64_t key, double resolution) {
+  const int64_t row = key >> 32;
+  const int32_t col = static_cast<int32_t>(key & 0xffffffffLL);
+  return {(static_cast<double>(row) + 0.5) * resolution,
+          (static_cast<double>(col) + 0.5) * resolution};
+}
+
+}  // namespace
 
 int64_t VisibilityRecord::key(double north, double east) const {
-  const int64_t r = static_cast<int64_t>(std::floor(north / resolution_));
-  const int64_t c = static_cast<int64_t>(std::floor(east / resolution_));
-  return (r << 32) ^ (c & 0xffffffffLL);
+  return cell_key(north, east, resolution_);
 }
 
 void VisibilityRecord::add_beam(const Vec3& origin, const Vec3& end, bool hit,
@@ -42,16 +59,55 @@ void VisibilityRecord::add_beam(const Vec3& origin, const Vec3& end, bool hit,
 void VisibilityRecord::forget_beyond(const Vec3& centre, double radius) {
   const double r2 = radius * radius;
   for (auto it = cells_.begin(); it != cells_.end();) {
-    const int64_t row = *it >> 32;
-    const int32_t col = static_cast<int32_t>(*it & 0xffffffffLL);
-    const double dn = (row + 0.5) * resolution_ - centre.x();
-    const double de = (col + 0.5) * resolution_ - centre.y();
+    const auto [north, east] = key_centre(*it, resolution_);
+    const double dn = north - centre.x(), de = east - centre.y();
     it = dn * dn + de * de > r2 ? cells_.erase(it) : std::next(it);
   }
 }
 
+int64_t ShadowMemory::key(double north, double east) const {
+  return cell_key(north, east, resolution_);
+}
+
+void ShadowMemory::remember(double north, double east, float top, double occluder_north,
+                            double occluder_east) {
+  Shadow& shadow = tops_[key(north, east)];
+  if (top > shadow.top) shadow = {top, occluder_north, occluder_east};
+}
+
+int ShadowMemory::apply(mapping::Heightfield& grid, const VisibilityRecord& visibility) {
+  int raised = 0;
+  for (auto it = tops_.begin(); it != tops_.end();) {
+    const auto [north, east] = key_centre(it->first, resolution_);
+    const Shadow& shadow = it->second;
+    const int orow = grid.row_of(shadow.occluder_north), ocol = grid.col_of(shadow.occluder_east);
+    const bool occluder_stands = grid.inside(orow, ocol) && grid.at(orow, ocol) >= shadow.top;
+    if (visibility.seen(north, east) || !occluder_stands) {
+      it = tops_.erase(it);
+      continue;
+    }
+    const int r = grid.row_of(north), c = grid.col_of(east);
+    if (grid.inside(r, c) && grid.at(r, c) < shadow.top) {
+      grid.at(r, c) = shadow.top;
+      ++raised;
+    }
+    ++it;
+  }
+  return raised;
+}
+
+void ShadowMemory::forget_beyond(const Vec3& centre, double radius) {
+  const double r2 = radius * radius;
+  for (auto it = tops_.begin(); it != tops_.end();) {
+    const auto [north, east] = key_centre(it->first, resolution_);
+    const double dn = north - centre.x(), de = east - centre.y();
+    it = dn * dn + de * de > r2 ? tops_.erase(it) : std::next(it);
+  }
+}
+
 int cast_occlusion_shadows(mapping::Heightfield& grid, const VisibilityRecord& visibility,
-                           const Vec3& vehicle, double altitude, double depth, double near) {
+                           const Vec3& vehicle, double altitude, double depth, double near,
+                           ShadowMemory* memory) {
   if (grid.empty() || !(depth > 0)) return 0;
   struct Occluder {
     int row, col;
@@ -77,6 +133,7 @@ int cast_occlusion_shadows(mapping::Heightfield& grid, const VisibilityRecord& v
       if (visibility.seen(n, e)) break;
       const int r = grid.row_of(n), c = grid.col_of(e);
       if (!grid.inside(r, c)) break;
+      if (memory) memory->remember(n, e, o.top, north, east);
       float& top = grid.at(r, c);
       if (top < o.top) {
         top = o.top;

@@ -36,10 +36,10 @@ PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhP
       start_clearance_(start_clearance),
       clearance_norm_(std::max(problem.limits.clearance + settings.clearance_margin, 1.0)),
       tau_(settings.time_constants),
-      max_speed_(problem.limits.max_speed),
-      max_vertical_speed_(problem.limits.max_vertical_speed),
+      max_speed_((1.0 - settings.speed_margin) * problem.limits.max_speed),
+      max_vertical_speed_((1.0 - settings.speed_margin) * problem.limits.max_vertical_speed),
       min_forward_speed_(problem.limits.min_forward_speed),
-      max_accel_(problem.limits.max_accel),
+      max_accel_((1.0 - settings.accel_margin) * problem.limits.max_accel),
       min_altitude_(settings.min_altitude),
       altitude_norm_(std::max(settings.min_altitude, 1.0)),
       ground_altitude_(settings.ground_altitude) {}
@@ -169,9 +169,17 @@ void RhNlp::set_problem(const RhProblem& problem) {
   start_acceleration_ = guidance_from_world * problem.acceleration;
   target_ = guidance_from_world * (problem.target - problem.position);
   terminal_x_ = problem.terminal_x - problem.frame.to_guidance(problem.position).x();
-  max_speed_ = problem.limits.max_speed;
-  max_vertical_speed_ = problem.limits.max_vertical_speed;
-  max_accel_ = problem.limits.max_accel;
+  // The reserve may not make the start infeasible: a start already in it
+  // (up to the limit itself) sets the bound instead.
+  const auto with_reserve = [](double limit, double margin, double at_start) {
+    return std::max((1.0 - margin) * limit, std::min(std::abs(at_start), limit));
+  };
+  max_speed_ =
+      with_reserve(problem.limits.max_speed, settings_.speed_margin, problem.velocity.norm());
+  max_vertical_speed_ =
+      with_reserve(problem.limits.max_vertical_speed, settings_.speed_margin, problem.velocity.z());
+  max_accel_ =
+      with_reserve(problem.limits.max_accel, settings_.accel_margin, problem.acceleration.norm());
   has_clearance_ = static_cast<bool>(problem.clearance);
   start_clearance_ = has_clearance_ ? problem.clearance(problem.position).distance
                                     : std::numeric_limits<double>::infinity();
@@ -261,11 +269,11 @@ void RhNlp::evaluate(const double* z) {
       integral_dt += quad_residual_(q, a) * quad_state_dt_(q, a);
     }
   }
-  cost_ = T * integral;
+  cost_ = T * integral + settings_.time_weight * T;
   for (int a = 0; a < 3; ++a)
     cost_gradient_.segment(a * f, f).noalias() =
         (T * kLengthScale) * qrows.rightCols(f).transpose() * quad_residual_.col(a);
-  cost_gradient_(nv - 1) = kTimeScale * (integral + T * integral_dt);
+  cost_gradient_(nv - 1) = kTimeScale * (integral + T * integral_dt + settings_.time_weight);
 
   // Path constraints at the collocation points after the start.
   const PointConstraintModel& model = *model_;

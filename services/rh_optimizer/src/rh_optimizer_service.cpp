@@ -66,6 +66,11 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   c.visibility_band = r.number_in("visibility_band", c.visibility_band, 0.1, 100.0);
   c.planned_initial_acceleration =
       r.boolean("planned_initial_acceleration", c.planned_initial_acceleration);
+  c.planned_initial_state = r.boolean("planned_initial_state", c.planned_initial_state);
+  c.replan_position_error =
+      r.number_in("replan_position_error", c.replan_position_error, 0.0, 1000.0);
+  c.replan_velocity_error =
+      r.number_in("replan_velocity_error", c.replan_velocity_error, 0.0, 100.0);
   c.defer_margin = r.number_in("defer_margin", c.defer_margin, 0.0, 1000.0);
 
   YamlReader field = r.child("distance_field");
@@ -81,7 +86,10 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   s.collocation_points = o.integer("collocation_points", s.collocation_points);
   s.time_constants = vec3_in(o, "time_constants", s.time_constants, 0.01, 10.0);
   s.weights = vec3_in(o, "weights", s.weights, 1e-3, 1e6);
+  s.time_weight = o.number_in("time_weight", s.time_weight, 0.0, 1e6);
   s.zero_terminal_accel = o.boolean("zero_terminal_accel", s.zero_terminal_accel);
+  s.speed_margin = o.number_in("speed_margin", s.speed_margin, 0.0, 0.5);
+  s.accel_margin = o.number_in("accel_margin", s.accel_margin, 0.0, 0.5);
   s.clearance_margin = o.number_in("clearance_margin", s.clearance_margin, 0.0, 100.0);
   s.min_altitude = o.number_in("min_altitude", s.min_altitude, 0.0, 1e4);
   s.ground_altitude = o.number_in("ground_altitude", s.ground_altitude, -1e4, 1e4);
@@ -220,6 +228,7 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   planner_.reset();
   switch_.reset();
   visibility_.clear();
+  shadows_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
                    m.mission_id, m.name, m.limits.clearance, config_.optimizer.clearance_margin,
                    m.limits.max_accel);
@@ -263,8 +272,11 @@ void RhOptimizerService::on_scan(const scan_world_t& m) {
   for (const auto& p : m.free_ray_ends)
     visibility_.add_beam(origin, Vec3(p[0], p[1], p[2]), false, altitude);
   // About every 10 s of scans: keep twice the sensor's reach around.
-  if (++scans_seen_ % 128 == 0)
-    visibility_.forget_beyond(origin, 2.0 * (mission_ ? mission_->limits.sensor_range : 100.0));
+  if (++scans_seen_ % 128 == 0) {
+    const double keep = 2.0 * (mission_ ? mission_->limits.sensor_range : 100.0);
+    visibility_.forget_beyond(origin, keep);
+    shadows_.forget_beyond(origin, keep);
+  }
 }
 
 bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
@@ -278,7 +290,13 @@ bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
   heightfield_ = padded_heightfield(*grid_, config_.field.max_distance + config_.occlusion_depth);
   const double ground = config_.optimizer.ground_altitude;
   const double alt = vehicle_altitude - ground;
-  cast_occlusion_shadows(heightfield_, visibility_, vehicle, alt, config_.occlusion_depth);
+  if (config_.occlusion_depth > 0) {
+    // Cast on the map alone (a shadow casts none of its own), then add
+    // the shadows remembered from earlier viewpoints.
+    cast_occlusion_shadows(heightfield_, visibility_, vehicle, alt, config_.occlusion_depth, 2.0,
+                           &shadows_);
+    shadows_.apply(heightfield_, visibility_);
+  }
   const double lo = std::max(0.0, alt - config_.field_altitude_band);
   const double hi = std::max(lo + 1.0, alt + config_.field_altitude_band);
   field_.build(heightfield_, lo, hi);
@@ -392,17 +410,31 @@ void RhOptimizerService::tick() {
   // carries the scanner's yaw-sweep oscillation and gust noise; the planned
   // one (or zero, as waypoint guidance commands in cruise, when avoidance
   // has just engaged) is what the controller was following.
-  if (config_.planned_initial_acceleration) {
-    p.acceleration = Vec3::Zero();
-    if (!last_trajectory_.empty()) {
-      const double since = to_seconds(now - last_trajectory_t0_);
-      if (since >= 0 && since <= last_trajectory_.duration())
-        p.acceleration = last_trajectory_.acceleration(since);
+  std::optional<double> since_plan;
+  if (!last_trajectory_.empty()) {
+    const double since = to_seconds(now - last_trajectory_t0_);
+    if (since >= 0 && since <= last_trajectory_.duration()) since_plan = since;
+  }
+  bool from_plan = false;
+  if (config_.planned_initial_state && since_plan) {
+    const Vec3 planned_position = last_trajectory_.position(*since_plan);
+    const Vec3 planned_velocity = last_trajectory_.velocity(*since_plan);
+    if ((planned_position - position).norm() <= config_.replan_position_error &&
+        (planned_velocity - velocity).norm() <= config_.replan_velocity_error) {
+      p.position = planned_position;
+      p.velocity = planned_velocity;
+      p.acceleration = last_trajectory_.acceleration(*since_plan);
+      from_plan = true;
     }
-  } else {
-    p.acceleration = to_vec3(nav_->acceleration);
-    const double norm = p.acceleration.norm();
-    if (norm > mission_->limits.max_accel) p.acceleration *= mission_->limits.max_accel / norm;
+  }
+  if (!from_plan) {
+    if (config_.planned_initial_acceleration) {
+      p.acceleration = since_plan ? last_trajectory_.acceleration(*since_plan) : Vec3::Zero();
+    } else {
+      p.acceleration = to_vec3(nav_->acceleration);
+      const double norm = p.acceleration.norm();
+      if (norm > mission_->limits.max_accel) p.acceleration *= mission_->limits.max_accel / norm;
+    }
   }
   p.target = leg.to;
   const double x_target = p.frame.to_guidance(leg.to).x();

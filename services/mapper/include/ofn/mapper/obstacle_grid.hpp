@@ -25,7 +25,7 @@ namespace ofn::mapping {
 struct ObstacleGridConfig {
   double resolution = 1.0;        // m per cell
   double half_extent = 70.0;      // m from the vehicle to the grid edge (>= sensor range)
-  double safety_margin = 1.5;     // m, horizontal inflation of every hit
+  double safety_margin = 0.5;     // m, horizontal inflation of every hit
   int smoothing_radius = 1;       // cells; neighbour averaging over (2r+1)^2, 0 = off
   double ground_altitude = 0;     // m, altitude of the flat ground
   double ground_clearance = 1.0;  // m; hits lower than this above the ground are ground

@@ -20,7 +20,7 @@ struct SwitchSettings {
   double engage_margin = 0.5;      // m beyond the clearance the nominal path must keep
   double rejoin_distance = 15.0;   // m ahead along the leg where nominal guidance rejoins it
   double check_spacing = 1.0;      // m between checked points of the nominal path
-  double handback_distance = 2.0;  // m from the leg within which avoidance may hand back
+  double handback_distance = 0.3;  // m from the leg within which avoidance may hand back
   double handback_hold = 1.0;      // s the nominal path must stay clear before handing back
 };
 

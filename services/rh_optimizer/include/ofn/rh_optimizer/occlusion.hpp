@@ -12,6 +12,7 @@
 // Pure core: the visibility record is fed from the scans by the service.
 
 #include <cstdint>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "ofn/common/frames.hpp"
@@ -45,13 +46,45 @@ class VisibilityRecord {
   std::unordered_set<int64_t> cells_;
 };
 
+/// Shadows once cast stay until a beam has seen through them. A shadow cast
+/// from where the vehicle is now points away from it: passing beside a
+/// cube seen from the front, the line of sight through its front face runs
+/// sideways, the space behind the face (the cube's unseen body) is no
+/// longer shadowed, and the optimiser turned back into it (bench4).
+class ShadowMemory {
+ public:
+  explicit ShadowMemory(double resolution = 1.0) : resolution_(resolution) {}
+
+  /// Remembers that the cell at (north, east) lies in the shadow of the
+  /// obstacle cell at (occluder_north, occluder_east), `top` high.
+  void remember(double north, double east, float top, double occluder_north, double occluder_east);
+  /// Forgets the cells a beam has crossed and those whose occluder is no
+  /// longer in `grid` as high, then raises every remembered cell of `grid`
+  /// to its remembered height. Returns the cells raised.
+  int apply(mapping::Heightfield& grid, const VisibilityRecord& visibility);
+  void forget_beyond(const Vec3& centre, double radius);
+  size_t size() const { return tops_.size(); }
+  void clear() { tops_.clear(); }
+
+ private:
+  int64_t key(double north, double east) const;
+
+  struct Shadow {
+    float top = 0;
+    double occluder_north = 0, occluder_east = 0;
+  };
+  double resolution_;
+  std::unordered_map<int64_t, Shadow> tops_;
+};
+
 /// Raises the hidden cells behind every obstacle cell taller than
 /// `vehicle_altitude` (m above ground), along the line of sight from the
 /// vehicle, up to `depth` metres beyond the cell or to the first seen cell.
 /// Cells within `near` metres of the vehicle cast no shadow. Returns the
 /// number of cells raised.
+/// With `memory`, every shadowed cell is also remembered there.
 int cast_occlusion_shadows(mapping::Heightfield& grid, const VisibilityRecord& visibility,
                            const Vec3& vehicle_ned, double vehicle_altitude, double depth,
-                           double near = 2.0);
+                           double near = 2.0, ShadowMemory* memory = nullptr);
 
 }  // namespace ofn::rh

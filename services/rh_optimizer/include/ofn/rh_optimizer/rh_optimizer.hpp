@@ -40,7 +40,18 @@ struct RhSettings {
   int collocation_points = 36;  // equally spaced in t over (0, T], constraints checked here
   Vec3 time_constants = Vec3(0.5, 0.5, 0.5);  // s, tau_x, tau_y, tau_z of Eq. 4
   Vec3 weights = Vec3(30.0, 10.0, 10.0);      // m, R_x, R_y, R_z of Eq. 1
-  bool zero_terminal_accel = false;           // Eq. 6: a(T) = 0 instead of free
+  /// Cost of each second of the horizon, added to Eq. 1 (0: the paper's
+  /// cost alone). Eq. 1 pays for time only through the distance still to
+  /// go, and near an obstacle it trades speed for deviation.
+  double time_weight = 0.0;
+  bool zero_terminal_accel = false;  // Eq. 6: a(T) = 0 instead of free
+  /// Shares of the speed and acceleration limits kept in reserve: the
+  /// constraints hold only at the collocation points (the acceleration
+  /// bulges a few per cent between them) and the vehicle tracks to a few
+  /// per cent; the benchmarks allow 2 % over a limit.
+  /// (0 here, the plain formulation; the service flies with a reserve.)
+  double speed_margin = 0.0;
+  double accel_margin = 0.0;
   double clearance_margin = 1.0;        // m planned beyond limits.clearance (tracking error room)
   double min_altitude = 6.0;            // m above ground
   double ground_altitude = 0.0;         // m; the ground is at world z = -ground_altitude

@@ -43,13 +43,31 @@ struct RhOptimizerServiceConfig {
   double visibility_band =
       3.0;  // m around flight altitude in which a crossing beam counts as a look
   bool planned_initial_acceleration = true;  // a(t0) from the last plan, not the nav solution
+  /// Position and velocity at t0 from the last plan too, while the vehicle
+  /// is within these errors of it. Starting every plan at the measured
+  /// state would reset the controller's reference to the vehicle ten times
+  /// a second: its feedback never acts, and each lag behind a manoeuvre
+  /// is accepted into the next plan (the vehicle slowed to half speed
+  /// topping bench1's wall while every plan said full speed).
+  bool planned_initial_state = true;
+  double replan_position_error = 3.0;  // m; farther from the plan, start from the vehicle
+  double replan_velocity_error = 1.5;  // m/s
   // Before a first avoidance trajectory exists, a failed solve brakes only
   // if the conflict is within braking distance plus this; otherwise nominal
   // guidance continues (DEFERRED) and the next tick tries again, typically
   // with the global route that the new obstacle is about to produce.
   double defer_margin = 10.0;  // m
   mapping::DistanceFieldConfig field;
-  RhSettings optimizer;
+  /// Flown with reserves on the speed and acceleration limits and a
+  /// smaller clearance margin than the core's plain defaults: measured on
+  /// the benchmark courses (README, "Planning and avoidance").
+  RhSettings optimizer = [] {
+    RhSettings s;
+    s.speed_margin = 0.01;
+    s.accel_margin = 0.06;
+    s.clearance_margin = 0.5;
+    return s;
+  }();
   FallbackSettings fallback;
   SwitchSettings avoidance;
 };
@@ -102,6 +120,7 @@ class RhOptimizerService {
   std::optional<obstacle_grid_t> grid_;
   bool grid_dirty_ = false;
   VisibilityRecord visibility_;
+  ShadowMemory shadows_;
   int64_t scans_seen_ = 0;
   mapping::Heightfield heightfield_;
   mapping::DistanceField field_;
