@@ -1,0 +1,307 @@
+#!/usr/bin/python3
+"""Monte Carlo over seeded random obstacle fields: success rate, clearance and time ratio.
+
+Usage: monte_carlo.py [--build DIR] [--runs N] [--seed-base S] [--jobs N] [--out DIR]
+                      [--keep-failures] [--keep-all] [--quick]
+
+Field i is bench/random_field.py's field of seed S + i (fair by construction;
+the rules are in that file). Each field is flown in the lockstep runner, N at
+a time, and, when the build has ofn_baseline, given its time-optimal baseline.
+Writes OUT/report.md, OUT/results.json (every run), OUT/clearance.png,
+OUT/time_ratio.png, OUT/fields/field-SEED.yaml and, for failed runs, a figure
+OUT/fig-seed-SEED.png.
+
+Kept on disk: the folder OUT/runs/seed-SEED/ of every failed run (CSVs,
+summary.json, runner output; with --keep-failures also its LCM log, tens of
+MB each); successful runs' folders are deleted unless --keep-all, since
+hundreds of flight logs would take gigabytes. Every run is deterministic
+given the seed, so any of them can be flown again alone: the report gives
+the command for each failure.
+
+Exit code 1 when the success rate is below 99 % (the goal), 2 for bad
+arguments; the report is written either way.
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+
+import campaign  # noqa: E402
+import campaign_report as cr  # noqa: E402
+import random_field  # noqa: E402
+
+SUCCESS_GOAL = 0.99
+QUICK_RUNS = 4
+MAX_FAILURE_FIGURES = 30
+PROGRESS_STEP = 0.05  # share of the runs between progress lines when stderr is not a terminal
+
+
+class Progress:
+    """Count, successes and ETA on stderr: one redrawn line on a terminal, a
+    line every ~5 % of the runs otherwise (logs, CI)."""
+
+    def __init__(self, total, stream=sys.stderr):
+        self.total, self.stream = total, stream
+        self.tty = stream.isatty()
+        self.t0 = time.monotonic()
+        self.done = self.ok = 0
+        self.next_line = 0
+
+    def update(self, success):
+        self.done += 1
+        self.ok += 1 if success else 0
+        elapsed = time.monotonic() - self.t0
+        eta = elapsed / self.done * (self.total - self.done)
+        text = "%d/%d fields, %d succeeded, %d failed, %s elapsed, ETA %s" % (
+            self.done, self.total, self.ok, self.done - self.ok, clock(elapsed), clock(eta))
+        if self.tty:
+            width = 30
+            filled = int(width * self.done / self.total)
+            self.stream.write("\r[%s%s] %s " % ("#" * filled, "." * (width - filled), text))
+            if self.done == self.total:
+                self.stream.write("\n")
+        elif self.done >= self.next_line or self.done == self.total:
+            self.stream.write("monte_carlo: %s\n" % text)
+            self.next_line = self.done + max(1, int(math.ceil(PROGRESS_STEP * self.total)))
+        self.stream.flush()
+
+
+def clock(seconds):
+    seconds = int(round(seconds))
+    return "%dm%02ds" % (seconds // 60, seconds % 60) if seconds >= 60 else "%ds" % seconds
+
+
+def rerun_commands(args, seed):
+    """Two exact ways to fly one field again alone."""
+    me = os.path.join(HERE, "monte_carlo.py")
+    gen = os.path.join(HERE, "random_field.py")
+    tpl = "" if os.path.realpath(args.template) == os.path.realpath(random_field.DEFAULT_TEMPLATE) \
+        else " --template " + os.path.abspath(args.template)
+    one = "%s --build %s --config-dir %s%s --seed %d --runs 1 --keep-all --out /tmp/mc-seed-%d" % (
+        me, args.build, args.config_dir, tpl, seed, seed)
+    two = ("%s --seed %d%s --out /tmp/field-%d.yaml && %s --scenario /tmp/field-%d.yaml --config-dir %s "
+           "--out /tmp/field-%d" % (gen, seed, tpl, seed, campaign.bin_path(args.build, "ofn_sim_runner"),
+                                    seed, args.config_dir, seed))
+    return one, two
+
+
+def fly_field(args, seed, template):
+    """Generate, fly and (if possible) baseline one field; tidy its folder."""
+    field = os.path.join(args.out, "fields", "field-%d.yaml" % seed)
+    obstacles = random_field.write_field(seed, field, template)
+    run_dir = os.path.join(args.out, "runs", "seed-%d" % seed)
+    rec = campaign.run_lockstep(args.build, field, run_dir, args.config_dir)
+    base = campaign.run_baseline(args.build, field, args.baseline_cache)
+    s = rec.get("summary") or {}
+    rs = s.get("clearance_required")
+    out = {
+        "seed": seed, "field": field, "obstacles": len(obstacles),
+        "tall_obstacles": sum(1 for o in obstacles if random_field.is_tall(o)),
+        "success": campaign.flight_ok(rec),
+        "failures": list(s.get("failures") or []) + ([rec["error"]] if rec.get("error") else []),
+        "gate_to_gate_s": s.get("gate_to_gate"),
+        "min_clearance_over_rs": s["min_clearance"] / rs if rs and s.get("min_clearance") is not None else None,
+        "baseline_status": base["status"], "baseline_time_s": base.get("baseline_time"),
+        "wall_s": rec["wall_s"], "dir": run_dir,
+    }
+    out["ratio"] = cr.ratio_of(out["gate_to_gate_s"], out["baseline_time_s"])
+    if out["success"] and not args.keep_all:
+        shutil.rmtree(run_dir, ignore_errors=True)
+        out["dir"] = None
+    elif not out["success"]:
+        if not args.keep_failures and not args.keep_all:
+            log = os.path.join(run_dir, "flight.lcm")
+            if os.path.isfile(log):
+                os.remove(log)
+        if len(os.listdir(os.path.join(args.out, "failure-figures"))) < MAX_FAILURE_FIGURES:
+            try:
+                out["figure"] = cr.course_figure(run_dir, os.path.join(args.out, "failure-figures",
+                                                                       "fig-seed-%d.png" % seed),
+                                                 title="field %d" % seed,
+                                                 baseline_dir=base["dir"] if base["status"] == "ok" else None)
+            except Exception as exc:  # the run's record matters more than its picture
+                out["figure_error"] = str(exc)
+    return out
+
+
+def straight_time(template):
+    """Gate-to-gate time of unobstructed straight flight at the speed limit."""
+    g, lim = template["gates"], template["limits"]
+    return (float(g["finish_x"]) - float(g["start_x"])) / float(lim["max_speed"])
+
+
+def write_report(args, runs, ctx):
+    n = len(runs)
+    ok = sum(1 for r in runs if r["success"])
+    lo, hi = cr.wilson_interval(ok, n)
+    rate = ok / n if n else 0.0
+    have_baseline = any(r["baseline_status"] != "n/a" for r in runs)
+    clear = [r["min_clearance_over_rs"] for r in runs]
+    cr.histogram(os.path.join(args.out, "clearance.png"), clear, "least true clearance / R_s",
+                 "least clearance to the real obstacles, %d fields" % n,
+                 lines=[(cr.FAIL_LINE, "0.8 R_s (fail)", "red"), (1.0, "R_s", "orange")])
+    t_ref = straight_time(ctx["template"])
+    if have_baseline:
+        ratios = [r["ratio"] for r in runs]
+        ratio_label, ratio_note = "gate-to-gate time / time-optimal baseline", ""
+    else:
+        ratios = [r["gate_to_gate_s"] / t_ref if r["gate_to_gate_s"] else None for r in runs]
+        ratio_label = "gate-to-gate time / unobstructed straight flight (%.1f s)" % t_ref
+        ratio_note = ("ofn_baseline is not in the build, so the time-ratio histogram divides by "
+                      "the unobstructed straight flight (%.1f s) instead of each field's baseline; "
+                      "the baseline columns read n/a." % t_ref)
+    cr.histogram(os.path.join(args.out, "time_ratio.png"), ratios, ratio_label,
+                 "time ratio, %d fields" % n,
+                 lines=[(campaign.RATIO_LIMIT, "%.3f" % campaign.RATIO_LIMIT, "red"),
+                        (campaign.RATIO_GOAL, "%.2f" % campaign.RATIO_GOAL, "orange")] if have_baseline else [])
+    finite = [v for v in ratios if v is not None]
+    lines = [
+        "# Monte Carlo: random obstacle fields",
+        "",
+        "- date: %s" % ctx["date"],
+        "- machine: %d cores, %s" % (ctx["machine"]["cores"], ctx["machine"]["cpu"]),
+        "- commit: %s" % ctx["commit"],
+        "- binaries: %s/bin, configuration %s" % (args.build, args.config_dir),
+        "- fields: seeds %d..%d (bench/random_field.py, course from %s), %d flown %d at a time"
+        % (args.seed_base, args.seed_base + args.runs - 1, os.path.relpath(ctx["template_path"], REPO), n,
+           args.jobs),
+        "- wall time: %.0f s in all, %.1f s per field (%.1f s per flight on one core); 1-minute "
+        "load average %.1f before, %.1f after" % (ctx["wall_s"], ctx["wall_s"] / max(n, 1),
+                                                  sum(r["wall_s"] for r in runs) / max(n, 1),
+                                                  ctx["load"][0], ctx["load"][1]),
+        "",
+        "Each field has 2-5 boxes and cylinders between x = 60 and 360 ft, low ones (top 40-150 ft) "
+        "to climb over and tall ones (250-300 ft) to pass beside, drawn so that a route with R_s "
+        "clearance always exists (the rules are in bench/random_field.py). A run fails if it misses "
+        "the finish gate, comes closer than 0.8 R_s to a real obstacle, or exceeds a limit by more "
+        "than 2 %.",
+        "",
+        "## Result",
+        "",
+        "| | |",
+        "|---|---|",
+        "| success rate | **%.1f %%** (%d of %d) |" % (100 * rate, ok, n),
+        "| 95 %% confidence interval (Wilson) | %.1f %% .. %.1f %% |" % (100 * lo, 100 * hi),
+        "| goal | >= %.0f %%: %s |" % (100 * SUCCESS_GOAL, "met" if rate >= SUCCESS_GOAL else "**not met**"),
+        "| least clearance / R_s | min %s, median %s |" % (
+            cr.fmt(min((c for c in clear if c is not None), default=None), 2),
+            cr.fmt(median([c for c in clear if c is not None]), 2)),
+        "| runs inside R_s | %d |" % sum(1 for c in clear if c is not None and c < 1.0),
+        "| time ratio (%s) | median %s, max %s |" % ("baseline" if have_baseline else "straight flight",
+                                                   cr.fmt(median(finite), 3),
+                                                   cr.fmt(max(finite, default=None), 3)),
+    ]
+    if ratio_note:
+        lines += ["", ratio_note]
+    lines += ["", "![least clearance](clearance.png)", "", "![time ratio](time_ratio.png)", "",
+              "## Failures", ""]
+    failed = [r for r in runs if not r["success"]]
+    if not failed:
+        lines.append("None.")
+    else:
+        lines += ["Folders kept in `runs/` (LCM log %s). Each command flies that field again, alone; "
+                  "the lockstep runner is deterministic given the field, up to the RH optimiser's "
+                  "wall-time cap per solve, which a busy machine can reach."
+                  % ("kept" if args.keep_failures or args.keep_all else "deleted; --keep-failures keeps it"),
+                  "", "| seed | obstacles (tall) | reason | re-run alone |", "|---|---|---|---|"]
+        for r in failed:
+            one, two = rerun_commands(args, r["seed"])
+            fig = " ([figure](failure-figures/%s))" % os.path.basename(r["figure"]) if r.get("figure") else ""
+            lines.append("| %d | %d (%d) | %s%s | `%s` <br> or `%s` |" % (
+                r["seed"], r["obstacles"], r["tall_obstacles"],
+                "; ".join(r["failures"]) or "unknown", fig, one, two))
+    with open(os.path.join(args.out, "report.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
+           "runs": n, "successes": ok, "success_rate": rate, "wilson95": [lo, hi],
+           "goal": SUCCESS_GOAL, "goal_met": rate >= SUCCESS_GOAL, "baselines_available": have_baseline,
+           "wall_s": ctx["wall_s"], "load_average": ctx["load"], "seed_base": args.seed_base,
+           "results": runs}
+    with open(os.path.join(args.out, "results.json"), "w") as f:
+        json.dump(doc, f, indent=1)
+    return rate
+
+
+def median(values):
+    vals = sorted(values)
+    if not vals:
+        return None
+    mid = len(vals) // 2
+    return vals[mid] if len(vals) % 2 else 0.5 * (vals[mid - 1] + vals[mid])
+
+
+def parse_args(argv):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--build", default=os.path.join(REPO, "build"), help="build folder (binaries in DIR/bin)")
+    ap.add_argument("--runs", type=int, default=None, help="number of fields (default 300)")
+    ap.add_argument("--seed-base", "--seed", dest="seed_base", type=int, default=1,
+                    help="seed of the first field; field i has seed S + i (default 1)")
+    ap.add_argument("--jobs", type=int, default=2, help="flights at a time")
+    ap.add_argument("--out", default=os.path.join(REPO, "results", "monte_carlo"))
+    ap.add_argument("--config-dir", default=campaign.DEFAULT_CONFIG,
+                    help="services' config files (default: the repository's)")
+    ap.add_argument("--template", default=random_field.DEFAULT_TEMPLATE,
+                    help="scenario whose course the fields use (default bench1)")
+    ap.add_argument("--baseline-cache", help="baseline cache folder (default OUT/baselines)")
+    ap.add_argument("--keep-failures", action="store_true",
+                    help="also keep the LCM logs of failed runs (their CSVs are always kept)")
+    ap.add_argument("--keep-all", action="store_true", help="keep every run's folder, log included")
+    ap.add_argument("--quick", action="store_true", help="%d fields" % QUICK_RUNS)
+    args = ap.parse_args(argv)
+    if args.runs is None:
+        args.runs = QUICK_RUNS if args.quick else 300
+    if args.runs < 1 or args.jobs < 1:
+        ap.error("--runs and --jobs must be >= 1")
+    args.build = os.path.abspath(args.build)
+    args.out = os.path.abspath(args.out)
+    args.config_dir = os.path.abspath(args.config_dir)
+    args.baseline_cache = os.path.abspath(args.baseline_cache or os.path.join(args.out, "baselines"))
+    if not os.access(campaign.bin_path(args.build, "ofn_sim_runner"), os.X_OK):
+        ap.error("no ofn_sim_runner in %s/bin (build first, or pass --build)" % args.build)
+    return args
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    template = random_field.load_template(args.template)
+    for sub in ("fields", "runs", "failure-figures"):
+        path = os.path.join(args.out, sub)
+        if sub != "fields" and os.path.isdir(path):
+            shutil.rmtree(path)  # results of an earlier campaign must not mix in
+        os.makedirs(path, exist_ok=True)
+    seeds = list(range(args.seed_base, args.seed_base + args.runs))
+    print("monte_carlo: %d fields (seeds %d..%d), %d at a time; binaries %s/bin; results in %s"
+          % (len(seeds), seeds[0], seeds[-1], args.jobs, args.build, args.out), flush=True)
+    if not os.access(campaign.bin_path(args.build, "ofn_baseline"), os.X_OK):
+        print("monte_carlo: no ofn_baseline in %s/bin: baselines and ratios will read n/a" % args.build,
+              flush=True)
+    load_before = os.getloadavg()[0]
+    progress = Progress(len(seeds))
+    t0 = time.monotonic()
+    results = campaign.run_all([(s, (lambda s=s: fly_field(args, s, args.template))) for s in seeds],
+                               args.jobs, lambda s, r, n: progress.update(r["success"]))
+    runs = [results[s] for s in seeds]
+    ctx = {"date": campaign.now_text(), "machine": campaign.machine_info(), "commit": campaign.git_commit(),
+           "template": template, "template_path": os.path.abspath(args.template),
+           "wall_s": time.monotonic() - t0, "load": (load_before, os.getloadavg()[0])}
+    rate = write_report(args, runs, ctx)
+    ok = sum(1 for r in runs if r["success"])
+    lo, hi = cr.wilson_interval(ok, len(runs))
+    print("success rate %.1f %% (%d/%d), 95 %% CI %.1f..%.1f %%; %.0f s wall, %.1f s per field"
+          % (100 * rate, ok, len(runs), 100 * lo, 100 * hi, ctx["wall_s"], ctx["wall_s"] / len(runs)))
+    for r in runs:
+        if not r["success"]:
+            print("  failed: seed %d: %s" % (r["seed"], "; ".join(r["failures"])))
+    print("report: %s" % os.path.join(args.out, "report.md"))
+    return 0 if rate >= SUCCESS_GOAL else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,313 @@
+#!/usr/bin/python3
+"""Seeded random obstacle fields over the benchmark course, written as scenario YAML.
+
+Usage: random_field.py --seed S --out FILE [--template sim/scenarios/bench1.yaml]
+
+The course (start, goal waypoint, limits, gates, max_time, units) is copied
+from the template, bench1 by default; only the obstacles are drawn. The same
+seed and template always give the same file, byte for byte.
+
+Fairness rules (every field that breaks one is redrawn from the same random
+stream, so the result is still a function of the seed alone). Lengths in ft,
+R_s = limits.clearance of the template (20 ft for bench1):
+
+  1. 2 to 5 obstacles, each wholly inside 60 <= x <= 360: the run-up from the
+     start (x = -100) past the start gate (x = 0) and the run-out past the
+     finish gate (x = 400) to the goal (x = 500) stay clear, so the clock
+     starts and stops in steady flight and every obstacle is in sensor range
+     (200 ft) well before the vehicle must react.
+  2. No obstacle within R_s + 30 of the start position or the goal waypoint.
+  3. Low obstacles (top 40..150, i.e. below flight altitude + 60) can always
+     be climbed over: their top plus R_s is at most 170, 50 above the
+     120 ft flight altitude, a 10 s climb at the 5 ft/s vertical limit that
+     fits in the >= 160 ft run-up of rule 1 (and anywhere else, since the
+     forward speed may drop to zero).
+  4. Tall obstacles (top 250..300) must be passed beside. Any two of them are
+     at least 2 R_s + 40 apart in plan, so their footprints grown by R_s are
+     disjoint with a corridor of at least 40 ft between any two. The plane
+     outside a finite set of disjoint convex regions is connected, so a
+     route at flight altitude with R_s clearance from every tall obstacle
+     always exists; where it crosses a low obstacle it climbs (rule 3).
+     Footprints are at most 120 ft across (a box diagonal <= 170 ft), so
+     every detour stays well inside the mapper's window.
+  5. Any two obstacles are at least R_s apart in plan, so no two of them
+     merge into one shape whose top the sensor cannot judge.
+  6. The first obstacle stands within 20 ft of the course line, so every
+     field makes the vehicle do something.
+
+Obstacles: boxes (footprint sides 20..120, yaw 0..180 deg) and cylinders
+(radius 10..30), as documented in docs/SCENARIO_FORMAT.md.
+"""
+import argparse
+import math
+import os
+import random
+import sys
+
+import yaml
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_TEMPLATE = os.path.join(REPO, "sim", "scenarios", "bench1.yaml")
+
+FIELD_X_MIN, FIELD_X_MAX = 60.0, 360.0
+LINE_Y_MAX = 100.0  # centres drawn within this distance of the course line
+FIRST_ON_LINE_Y = 20.0
+END_MARGIN_BEYOND_RS = 30.0
+TALL_CORRIDOR_BEYOND_2RS = 40.0
+LOW_TOP = (40.0, 150.0)
+TALL_TOP = (250.0, 300.0)
+BOX_SIDE = (20.0, 120.0)
+CYLINDER_RADIUS = (10.0, 30.0)
+TALL_SHARE = 0.5
+BOX_SHARE = 0.6
+COUNT = (2, 5)
+CIRCLE_SEGMENTS = 48  # cylinders as polygons for the plan distances; error < 0.3 % of the radius
+MAX_DRAWS = 10000
+
+
+def load_template(path):
+    with open(path) as f:
+        tpl = yaml.safe_load(f)
+    for key in ("units", "start", "waypoints", "limits", "gates"):
+        if key not in tpl:
+            raise ValueError("%s: template has no '%s'" % (path, key))
+    return tpl
+
+
+def footprint(ob):
+    """Plan outline (x, y) of an obstacle as a convex polygon, counter-clockwise or not."""
+    cx, cy = ob["center"]
+    if ob["kind"] == "cylinder":
+        r = ob["radius"]
+        return [(cx + r * math.cos(a), cy + r * math.sin(a))
+                for a in (2 * math.pi * i / CIRCLE_SEGMENTS for i in range(CIRCLE_SEGMENTS))]
+    a, b = ob["size"]
+    yaw = math.radians(ob.get("yaw_deg", 0.0))
+    c, s = math.cos(yaw), math.sin(yaw)
+    local = [(a / 2, b / 2), (-a / 2, b / 2), (-a / 2, -b / 2), (a / 2, -b / 2)]
+    return [(cx + x * c - y * s, cy + x * s + y * c) for x, y in local]
+
+
+def _point_segment(p, a, b):
+    ax, ay = a
+    dx, dy = b[0] - ax, b[1] - ay
+    L2 = dx * dx + dy * dy
+    t = 0.0 if L2 == 0 else max(0.0, min(1.0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / L2))
+    return math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy)
+
+
+def _inside(p, poly):
+    """Point in convex polygon (either orientation)."""
+    sign = 0
+    for i in range(len(poly)):
+        a, b = poly[i], poly[(i + 1) % len(poly)]
+        cross = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+        if cross != 0:
+            if sign == 0:
+                sign = 1 if cross > 0 else -1
+            elif (cross > 0) != (sign > 0):
+                return False
+    return True
+
+
+def _separating_axis(p, q):
+    """True when an edge normal of p or q separates the two convex polygons."""
+    for poly in (p, q):
+        for i in range(len(poly)):
+            a, b = poly[i], poly[(i + 1) % len(poly)]
+            nx, ny = b[1] - a[1], a[0] - b[0]
+            pp = [nx * x + ny * y for x, y in p]
+            qq = [nx * x + ny * y for x, y in q]
+            if max(pp) < min(qq) or max(qq) < min(pp):
+                return True
+    return False
+
+
+def plan_distance(p, q):
+    """Least distance between two convex polygons; 0 when they overlap."""
+    if not _separating_axis(p, q):
+        return 0.0
+    best = math.inf
+    for poly, other in ((p, q), (q, p)):
+        for v in poly:
+            for i in range(len(other)):
+                best = min(best, _point_segment(v, other[i], other[(i + 1) % len(other)]))
+    return best
+
+
+def point_distance(pt, poly):
+    if _inside(pt, poly):
+        return 0.0
+    return min(_point_segment(pt, poly[i], poly[(i + 1) % len(poly)]) for i in range(len(poly)))
+
+
+def is_tall(ob):
+    return ob["height"] >= TALL_TOP[0]
+
+
+def rule_violations(obstacles, tpl):
+    """Every broken fairness rule, as text; empty for a fair field."""
+    rs = float(tpl["limits"].get("clearance", 0.0))
+    start = tpl["start"]["position"][:2]
+    goal = tpl["waypoints"][-1]["position"][:2]
+    shapes = [footprint(ob) for ob in obstacles]
+    out = []
+    if not COUNT[0] <= len(obstacles) <= COUNT[1]:
+        out.append("%d obstacles" % len(obstacles))
+    for i, (ob, poly) in enumerate(zip(obstacles, shapes)):
+        xs = [x for x, _ in poly]
+        if min(xs) < FIELD_X_MIN or max(xs) > FIELD_X_MAX:
+            out.append("obstacle %d outside %g <= x <= %g" % (i + 1, FIELD_X_MIN, FIELD_X_MAX))
+        for name, pt in (("start", start), ("goal", goal)):
+            if point_distance(pt, poly) < rs + END_MARGIN_BEYOND_RS:
+                out.append("obstacle %d within R_s + %g of the %s" % (i + 1, END_MARGIN_BEYOND_RS, name))
+        for j in range(i):
+            d = plan_distance(poly, shapes[j])
+            need = rs
+            if is_tall(ob) and is_tall(obstacles[j]):
+                need = 2 * rs + TALL_CORRIDOR_BEYOND_2RS
+            if d < need:
+                out.append("obstacles %d and %d %.1f apart (< %.1f)" % (j + 1, i + 1, d, need))
+    if obstacles and abs(obstacles[0]["center"][1]) > FIRST_ON_LINE_Y:
+        out.append("obstacle 1 off the course line")
+    return out
+
+
+def _draw_obstacle(rng, on_line):
+    tall = rng.random() < TALL_SHARE
+    height = rng.uniform(*(TALL_TOP if tall else LOW_TOP))
+    y_max = FIRST_ON_LINE_Y if on_line else LINE_Y_MAX
+    if rng.random() < BOX_SHARE:
+        ob = {"kind": "box", "size": [rng.uniform(*BOX_SIDE), rng.uniform(*BOX_SIDE)],
+              "yaw_deg": rng.uniform(0.0, 180.0)}
+    else:
+        ob = {"kind": "cylinder", "radius": rng.uniform(*CYLINDER_RADIUS)}
+    ob["center"] = [rng.uniform(FIELD_X_MIN, FIELD_X_MAX), rng.uniform(-y_max, y_max)]
+    ob["height"] = height
+    return _rounded(ob)
+
+
+def _rounded(ob):
+    """Round to 0.1 ft (0.1 deg) before the rule checks, so the checked field is the written one."""
+    r = {"kind": ob["kind"], "center": [round(v, 1) for v in ob["center"]]}
+    if "size" in ob:
+        r["size"] = [round(v, 1) for v in ob["size"]]
+        r["yaw_deg"] = round(ob["yaw_deg"], 1)
+    else:
+        r["radius"] = round(ob["radius"], 1)
+    r["height"] = round(ob["height"], 1)
+    return r
+
+
+def generate(seed, tpl):
+    """(obstacles, redraws): a fair field, a function of the seed and the template only.
+
+    Obstacles are placed one by one, each redrawn until it keeps the rules
+    with those already placed; a field that cannot be completed that way
+    within a bounded number of draws is started afresh from the same stream.
+    """
+    rng = random.Random(seed)
+    draws = 0
+    while draws < MAX_DRAWS:
+        count = rng.randint(*COUNT)
+        obstacles = []
+        for k in range(count):
+            for _ in range(200):
+                draws += 1
+                ob = _draw_obstacle(rng, on_line=(k == 0))
+                trial = obstacles + [ob]
+                if not [v for v in rule_violations(trial, tpl) if not v.endswith(" obstacles")]:
+                    obstacles = trial
+                    break
+            else:
+                break
+        if len(obstacles) == count and not rule_violations(obstacles, tpl):
+            return obstacles, draws
+    raise RuntimeError("seed %d: no fair field in %d draws" % (seed, MAX_DRAWS))
+
+
+def _num(v):
+    return ("%.1f" % v).rstrip("0").rstrip(".") if v != int(v) else "%d" % int(v)
+
+
+def _vec(v):
+    return "[" + ", ".join(_num(float(x)) for x in v) + "]"
+
+
+def field_yaml(seed, obstacles, tpl, template_name):
+    """Scenario text in the bench file layout."""
+    start, lim, gates = tpl["start"], tpl["limits"], tpl["gates"]
+    lines = [
+        "# Random obstacle field, seed %d (bench/random_field.py; course from %s)." % (seed, template_name),
+        "# Regenerate: bench/random_field.py --seed %d --out FILE" % seed,
+        "name: field-%d" % seed,
+        "description: random field %d, %d obstacles (%d tall)"
+        % (seed, len(obstacles), sum(1 for o in obstacles if is_tall(o))),
+        "units: %s" % tpl["units"],
+        "start:",
+        "  position: %s" % _vec(start["position"]),
+    ]
+    for key in ("speed", "heading_deg"):
+        if key in start:
+            lines.append("  %s: %s" % (key, _num(float(start[key]))))
+    lines.append("waypoints:")
+    for wp in tpl["waypoints"]:
+        lines.append("  - position: %s" % _vec(wp["position"]))
+        if "capture_radius" in wp:
+            lines.append("    capture_radius: %s" % _num(float(wp["capture_radius"])))
+    for key in ("capture_radius", "cruise_speed"):
+        if key in tpl:
+            lines.append("%s: %s" % (key, _num(float(tpl[key]))))
+    lines.append("limits:")
+    for key, value in lim.items():
+        lines.append("  %s: %s" % (key, _num(float(value))))
+    lines.append("gates:")
+    for key, value in gates.items():
+        lines.append("  %s: %s" % (key, _num(float(value))))
+    lines.append("obstacles:")
+    for i, ob in enumerate(obstacles):
+        lines.append("  - kind: %s" % ob["kind"])
+        lines.append("    id: %d" % (i + 1))
+        lines.append("    center: %s" % _vec(ob["center"]))
+        if ob["kind"] == "box":
+            lines.append("    size: %s" % _vec(ob["size"]))
+            lines.append("    yaw_deg: %s" % _num(ob["yaw_deg"]))
+        else:
+            lines.append("    radius: %s" % _num(ob["radius"]))
+        lines.append("    height: %s%s" % (_num(ob["height"]), "   # tall: pass beside" if is_tall(ob)
+                                          else "   # low: may climb over"))
+    if "max_time" in tpl:
+        lines.append("max_time: %s" % _num(float(tpl["max_time"])))
+    return "\n".join(lines) + "\n"
+
+
+def write_field(seed, path, template=DEFAULT_TEMPLATE):
+    """Write the field of `seed` to `path`; returns its obstacle list."""
+    tpl = load_template(template)
+    obstacles, _ = generate(seed, tpl)
+    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO))
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w") as f:
+        f.write(text)
+    return obstacles
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seed", type=int, required=True)
+    ap.add_argument("--out", required=True, help="scenario file to write")
+    ap.add_argument("--template", default=DEFAULT_TEMPLATE,
+                    help="scenario whose course (start, waypoints, limits, gates) is used")
+    args = ap.parse_args()
+    try:
+        obstacles = write_field(args.seed, args.out, args.template)
+    except (OSError, ValueError, RuntimeError) as exc:
+        print("random_field: error: %s" % exc, file=sys.stderr)
+        return 2
+    print("%s: %d obstacles (%d tall)" % (args.out, len(obstacles),
+                                          sum(1 for o in obstacles if is_tall(o))))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# The benchmark campaign and the Monte Carlo fields in their short forms:
+# bench1 and bench4 through campaign.py --quick and four random fields
+# through monte_carlo.py --quick. Both courses and every field must succeed
+# (finish gate, no limit exceeded by more than 2 %), both courses must stay
+# outside R_s of the real obstacles, and the reports and figures must be
+# written.
+source "$(dirname "$0")/common.sh"
+build=$(cd "$BIN/.." && pwd)
+status=0
+/usr/bin/python3 "$REPO/bench/campaign.py" --build "$build" --quick --out "$WORK/campaign" \
+  > "$WORK/campaign.txt" 2>&1 || status=$?
+cat "$WORK/campaign.txt"
+/usr/bin/python3 "$REPO/bench/monte_carlo.py" --build "$build" --quick --out "$WORK/monte_carlo" \
+  > "$WORK/monte_carlo.txt" 2>&1 || status=$?
+cat "$WORK/monte_carlo.txt"
+/usr/bin/python3 - "$WORK" <<'PY' || fail "the campaign or the random fields did not come out as required"
+import json, os, sys
+work = sys.argv[1]
+ok = True
+
+def need(cond, what):
+    global ok
+    if not cond:
+        print("missing or wrong: " + what)
+        ok = False
+
+def nonempty(path):
+    return os.path.isfile(path) and os.path.getsize(path) > 0
+
+camp = os.path.join(work, "campaign")
+need(nonempty(os.path.join(camp, "report.md")), "campaign/report.md")
+need(os.path.isfile(os.path.join(camp, "results.json")), "campaign/results.json")
+if ok:
+    res = json.load(open(os.path.join(camp, "results.json")))
+    courses = {c["course"]: c for c in res["courses"]}
+    for name in ("bench1", "bench4"):
+        c = courses.get(name)
+        need(c is not None, "%s in campaign/results.json" % name)
+        if c is None:
+            continue
+        print("%s: success %s, least clearance %s (R_s %s) %s" % (
+            name, c["success"], c.get("min_clearance"), c.get("clearance_required"), c.get("display_unit")))
+        need(c["success"], "%s succeeded (%s)" % (name, "; ".join(c.get("failures") or [])))
+        need(c.get("min_clearance") is not None and c["min_clearance"] >= c["clearance_required"],
+             "%s least clearance >= R_s" % name)
+        need(nonempty(os.path.join(camp, "fig-%s.png" % name)), "campaign/fig-%s.png" % name)
+mc = os.path.join(work, "monte_carlo")
+for name in ("report.md", "results.json", "clearance.png", "time_ratio.png"):
+    need(nonempty(os.path.join(mc, name)), "monte_carlo/" + name)
+if os.path.isfile(os.path.join(mc, "results.json")):
+    res = json.load(open(os.path.join(mc, "results.json")))
+    for r in res["results"]:
+        print("field %d: success %s %s" % (r["seed"], r["success"], "; ".join(r["failures"])))
+    need(res["runs"] == 4 and res["successes"] == 4, "all 4 random fields succeeded")
+sys.exit(0 if ok else 1)
+PY
+[[ $status == 0 ]] || fail "campaign.py or monte_carlo.py exit code $status"
+pass "bench1 and bench4 succeeded outside R_s, four random fields succeeded, reports and figures written"
