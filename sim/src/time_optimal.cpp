@@ -14,6 +14,7 @@
 
 #include "ofn/global_planner/global_planner.hpp"
 #include "ofn/rh_optimizer/bspline.hpp"
+#include "ofn/rh_optimizer/rh_optimizer.hpp"
 #include "ofn/world/world.hpp"
 
 namespace ofn::baseline {
@@ -338,33 +339,6 @@ class Programme {
   std::vector<std::array<Eigen::RowVectorXd, 3>> rows_;
 };
 
-const char* result_name(nlopt_result result) {
-  switch (result) {
-    case NLOPT_SUCCESS:
-      return "success";
-    case NLOPT_STOPVAL_REACHED:
-      return "stopval reached";
-    case NLOPT_FTOL_REACHED:
-      return "ftol reached";
-    case NLOPT_XTOL_REACHED:
-      return "xtol reached";
-    case NLOPT_MAXEVAL_REACHED:
-      return "evaluation limit";
-    case NLOPT_MAXTIME_REACHED:
-      return "time limit";
-    case NLOPT_ROUNDOFF_LIMITED:
-      return "roundoff limited";
-    case NLOPT_FORCED_STOP:
-      return "forced stop";
-    case NLOPT_OUT_OF_MEMORY:
-      return "out of memory";
-    case NLOPT_INVALID_ARGS:
-      return "invalid arguments";
-    default:
-      return "failure";
-  }
-}
-
 struct SolveContext {
   const Programme* programme = nullptr;
   int evaluations = 0;
@@ -657,7 +631,7 @@ Solved solve_guess(const Course& c, const Guess& guess, const BaselineSettings& 
     double value = 0;
     const nlopt_result status = nlopt_optimize(opt, z.data(), &value);
     nlopt_destroy(opt);
-    out.summary.solver_status = result_name(status);
+    out.summary.solver_status = rh::nlopt_result_name(status);
     out.summary.evaluations += context.evaluations;
     if (!std::all_of(z.begin(), z.end(), [](double v) { return std::isfinite(v); }) || !(z[0] > 0))
       break;

@@ -97,35 +97,6 @@ void split_equality_callback(unsigned, double* values, unsigned n, const double*
   }
 }
 
-const char* result_name(nlopt_result result) {
-  switch (result) {
-    case NLOPT_SUCCESS:
-      return "success";
-    case NLOPT_STOPVAL_REACHED:
-      return "stopval reached";
-    case NLOPT_FTOL_REACHED:
-      return "ftol reached";
-    case NLOPT_XTOL_REACHED:
-      return "xtol reached";
-    case NLOPT_MAXEVAL_REACHED:
-      return "iteration limit";
-    case NLOPT_MAXTIME_REACHED:
-      return "time limit";
-    case NLOPT_FAILURE:
-      return "failure";
-    case NLOPT_INVALID_ARGS:
-      return "invalid arguments";
-    case NLOPT_OUT_OF_MEMORY:
-      return "out of memory";
-    case NLOPT_ROUNDOFF_LIMITED:
-      return "roundoff limited";
-    case NLOPT_FORCED_STOP:
-      return "forced stop";
-    default:
-      return "unknown result";
-  }
-}
-
 std::string problem_error(const RhProblem& problem) {
   if (!finite(problem.position) || !finite(problem.velocity) || !finite(problem.acceleration))
     return "non-finite start state";
@@ -159,6 +130,35 @@ void sample_guess(const BsplineTrajectory* trajectory, double from, double until
 }
 
 }  // namespace
+
+const char* nlopt_result_name(int result) {
+  switch (static_cast<nlopt_result>(result)) {
+    case NLOPT_SUCCESS:
+      return "success";
+    case NLOPT_STOPVAL_REACHED:
+      return "stopval reached";
+    case NLOPT_FTOL_REACHED:
+      return "ftol reached";
+    case NLOPT_XTOL_REACHED:
+      return "xtol reached";
+    case NLOPT_MAXEVAL_REACHED:
+      return "evaluation limit";
+    case NLOPT_MAXTIME_REACHED:
+      return "time limit";
+    case NLOPT_FAILURE:
+      return "failure";
+    case NLOPT_INVALID_ARGS:
+      return "invalid arguments";
+    case NLOPT_OUT_OF_MEMORY:
+      return "out of memory";
+    case NLOPT_ROUNDOFF_LIMITED:
+      return "roundoff limited";
+    case NLOPT_FORCED_STOP:
+      return "forced stop";
+    default:
+      return "unknown result";
+  }
+}
 
 // ---------------------------------------------------------------------------
 
@@ -314,7 +314,7 @@ SolveReport RhOptimizer::solve(const RhProblem& problem, const InitialGuess& gue
   report.cost = nlp.cost(chosen.data());
   report.feasible = context.have_feasible;
   std::ostringstream message;
-  message << result_name(result);
+  message << nlopt_result_name(result);
   if (!report.feasible) message << "; no feasible point, least violation " << report.max_violation;
   if (chosen.allFinite() && std::isfinite(report.cost)) {
     BsplineTrajectory trajectory = nlp.trajectory(chosen.data());

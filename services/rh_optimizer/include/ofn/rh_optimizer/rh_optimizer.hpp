@@ -30,6 +30,10 @@
 
 namespace ofn::rh {
 
+/// A short name for an NLopt result code (`nlopt_result`, passed as int so
+/// that this header does not pull in nlopt.h), for solve reports.
+const char* nlopt_result_name(int result);
+
 /// The NLopt algorithm of a solve. SLSQP is the design's choice; MMA (with
 /// each equality as a pair of inequalities) is kept for comparison.
 enum class RhAlgorithm { kSlsqp, kMma };
