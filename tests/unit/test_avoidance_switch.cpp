@@ -102,5 +102,20 @@ TEST(AvoidanceSwitch, EngagesAtOnceAndHandsBackOnlyWhenClearAndNearTheLeg) {
   EXPECT_FALSE(sw.update(8.6, false, 0.0));
 }
 
+TEST(AvoidanceSwitch, StoppingAtTheLastWaypointHandsBackOnlyWhenSlow) {
+  SwitchSettings s;
+  s.handback_hold = 1.0;
+  s.handback_stop_speed = 0.3;
+  AvoidanceSwitch sw(s);
+  EXPECT_TRUE(sw.update(0.0, true, 0.0));
+  // Clear, on the leg, but still braking for the waypoint at 1.3 m/s:
+  // waypoint guidance could not stop in the metres left.
+  EXPECT_TRUE(sw.update(0.1, false, 0.0, 1.3));
+  EXPECT_TRUE(sw.update(2.0, false, 0.0, 1.3));
+  EXPECT_TRUE(sw.update(3.0, false, 0.0, 0.31));
+  // Nearly at rest on the waypoint: hands back.
+  EXPECT_FALSE(sw.update(3.5, false, 0.0, 0.2));
+}
+
 }  // namespace
 }  // namespace ofn::rh

@@ -158,14 +158,17 @@ void expect_meets_constraints(const RhOptimizer& optimizer, const RhProblem& pro
 TEST(RhNlp, GradientsMatchCentralDifferences) {
   const Course course = load_course(
       "bench1", {{-100, 0, 120}, {20, 0, 120}, {150, 0, 180}, {260, 0, 180}, {500, 0, 120}});
-  for (const bool zero_accel : {false, true}) {
+  // The plain terminal rows, then every optional one (zero a(T) and the
+  // stop at the target, whose rows follow the a(T) rows).
+  for (const bool optional_rows : {false, true}) {
     RhSettings settings;
-    settings.zero_terminal_accel = zero_accel;
+    settings.zero_terminal_accel = optional_rows;
     RhNlp nlp(settings, BsplineBasis(settings.degree, settings.intervals));
     // Near the wall and a little inside the planned clearance, so that the
     // clearance gradient and its growing requirement are both exercised.
     RhProblem problem = course_problem(course, feet(180, 0, 150));
     problem.acceleration = Vec3(0.1, -0.05, -0.2);
+    problem.stop_at_target = optional_rows;
     nlp.set_problem(problem);
     ASSERT_LT(nlp.start_clearance(), problem.limits.clearance + settings.clearance_margin);
     nlp.set_cost_scale(37.0);
@@ -254,6 +257,33 @@ TEST(RhOptimizer, OpenSpaceFromAStraightGuess) {
     EXPECT_GT(report.trajectory.velocity(report.trajectory.duration()).norm(),
               0.9 * open.limits.max_speed);
   }
+}
+
+TEST(RhOptimizer, StopsAtRestOnTheLastWaypoint) {
+  // The last waypoint 40 m ahead, the vehicle 3 m beside the leg at cruise
+  // speed: the trajectory ends on the waypoint at rest, within the limits.
+  const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
+  RhOptimizer optimizer;
+  RhProblem problem;
+  problem.frame =
+      GuidanceFrame::from_leg(open.waypoints.front().position, open.waypoints.back().position);
+  problem.limits = open.limits;
+  problem.target = open.waypoints.back().position;
+  problem.terminal_x = problem.frame.to_guidance(problem.target).x();
+  problem.position = problem.frame.to_world(Vec3(problem.terminal_x - 40.0, 3.0, 0.0));
+  problem.velocity = problem.frame.world_from_guidance.col(0) * open.cruise_speed;
+  problem.stop_at_target = true;
+  const SolveReport report = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
+  expect_meets_constraints(optimizer, problem, report, "stop at the last waypoint");
+  const double T = report.trajectory.duration();
+  EXPECT_LT((report.trajectory.position(T) - problem.target).norm(), 0.05);
+  EXPECT_LT(report.trajectory.velocity(T).norm(), 0.02);
+
+  // Without the stop, the same problem only reaches the waypoint's x.
+  problem.stop_at_target = false;
+  const SolveReport passing = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
+  ASSERT_TRUE(passing.feasible) << passing.message;
+  EXPECT_GT(passing.trajectory.velocity(passing.trajectory.duration()).norm(), 1.0);
 }
 
 struct CourseCase {

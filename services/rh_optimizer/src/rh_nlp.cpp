@@ -169,6 +169,7 @@ void RhNlp::set_problem(const RhProblem& problem) {
   start_acceleration_ = guidance_from_world * problem.acceleration;
   target_ = guidance_from_world * (problem.target - problem.position);
   terminal_x_ = problem.terminal_x - problem.frame.to_guidance(problem.position).x();
+  stop_at_target_ = problem.stop_at_target;
   // Bounds of the terminal speed rows and of the control points: a start
   // already inside the reserve (up to the limit itself) sets them. The
   // path constraints (PointConstraintModel) keep the plain reserve: relieved
@@ -200,7 +201,7 @@ int RhNlp::num_inequalities() const {
 }
 
 int RhNlp::num_equalities() const {
-  return settings_.zero_terminal_accel ? 5 : 2;
+  return 2 + (settings_.zero_terminal_accel ? 3 : 0) + (stop_at_target_ ? 4 : 0);
 }
 
 void RhNlp::bounds(std::vector<double>& lower, std::vector<double>& upper) const {
@@ -315,10 +316,21 @@ void RhNlp::evaluate(const double* z) {
                1.0 / kLengthScale);
   terminal_row(eq_values_, eq_jacobian_, 1, state_[1](last, 2) / max_vertical_speed_, 1, 2,
                1.0 / max_vertical_speed_);
+  int eq_row = 2;
   if (settings_.zero_terminal_accel)
     for (int a = 0; a < 3; ++a)
-      terminal_row(eq_values_, eq_jacobian_, 2 + a, state_[2](last, a) / max_accel_, 2, a,
+      terminal_row(eq_values_, eq_jacobian_, eq_row++, state_[2](last, a) / max_accel_, 2, a,
                    1.0 / max_accel_);
+  if (stop_at_target_) {
+    // At rest on the target: its y and z, no forward or sideways speed (x
+    // and the vertical speed are the rows above).
+    for (int a = 1; a < 3; ++a)
+      terminal_row(eq_values_, eq_jacobian_, eq_row++,
+                   (state_[0](last, a) - target_(a)) / kLengthScale, 0, a, 1.0 / kLengthScale);
+    for (int a = 0; a < 2; ++a)
+      terminal_row(eq_values_, eq_jacobian_, eq_row++, state_[1](last, a) / max_speed_, 1, a,
+                   1.0 / max_speed_);
+  }
 }
 
 void RhNlp::jacobian_row(int point, const Eigen::Matrix<double, 4, 3>& partial,

@@ -374,6 +374,13 @@ ConstraintReport RhOptimizer::check(const RhProblem& problem, const BsplineTraje
                               std::abs(end_velocity.y()) / l.max_speed - 1.0});
   if (settings_.zero_terminal_accel)
     terminal = std::max(terminal, end_accel.cwiseAbs().maxCoeff() / l.max_accel);
+  if (problem.stop_at_target) {
+    const Vec3 target_offset = guidance_from_world * (problem.target - problem.frame.origin);
+    terminal = std::max(
+        {terminal,
+         (end_offset - target_offset).tail<2>().cwiseAbs().maxCoeff() / RhNlp::kLengthScale,
+         end_velocity.head<2>().cwiseAbs().maxCoeff() / l.max_speed});
+  }
   report.terminal = terminal;
   return report;
 }

@@ -126,6 +126,7 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   w.check_spacing = a.number_in("check_spacing", w.check_spacing, 0.1, 10.0);
   w.handback_distance = a.number_in("handback_distance", w.handback_distance, 0.0, 100.0);
   w.handback_hold = a.number_in("handback_hold", w.handback_hold, 0.0, 60.0);
+  w.handback_stop_speed = a.number_in("handback_stop_speed", w.handback_stop_speed, 0.0, 100.0);
   a.finish();
   r.finish();
   return c;
@@ -227,6 +228,7 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   active_leg_ = -1;
   planner_.reset();
   switch_.reset();
+  stopping_at_target_ = false;
   visibility_.clear();
   shadows_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
@@ -329,6 +331,7 @@ void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& 
   node_.publish(channels::kRefTraj, m);
   planner_.reset();
   last_trajectory_ = BsplineTrajectory();
+  stopping_at_target_ = false;
   node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
                    why);
 }
@@ -388,7 +391,9 @@ void RhOptimizerService::tick() {
   const bool conflict = std::isfinite(nominal.conflict_distance);
   const bool was_engaged = switch_.engaged();
   const double t = to_seconds(now);
-  const bool engaged = switch_.update(t, conflict, cross_track_distance(leg, position));
+  const double stopping_speed = stopping_at_target_ ? velocity.norm() : 0.0;
+  const bool engaged =
+      switch_.update(t, conflict, cross_track_distance(leg, position), stopping_speed);
   if (!engaged) {
     if (was_engaged) hand_back(now, position, velocity, "nominal path clear, back on the leg");
     note("nominal guidance");
@@ -442,6 +447,11 @@ void RhOptimizerService::tick() {
   p.terminal_x =
       terminal_x(p.frame, heightfield_, position, limits.sensor_range,
                  limits.clearance + config_.optimizer.clearance_margin, x_target, min_horizon);
+  // With the last waypoint within the horizon, plan the stop there: a
+  // trajectory that only has to reach its x would arrive at cruise speed and
+  // leave waypoint guidance no room to brake.
+  p.stop_at_target = active->final && p.terminal_x >= x_target;
+  stopping_at_target_ = p.stop_at_target;
   p.limits = limits;
   p.clearance = clearance;
   in.time = t;

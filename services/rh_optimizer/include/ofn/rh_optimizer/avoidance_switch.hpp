@@ -22,6 +22,10 @@ struct SwitchSettings {
   double check_spacing = 1.0;      // m between checked points of the nominal path
   double handback_distance = 0.3;  // m from the leg within which avoidance may hand back
   double handback_hold = 1.0;      // s the nominal path must stay clear before handing back
+  /// m/s; while avoidance is stopping the vehicle at the last waypoint, it
+  /// hands back only this slow: guidance resumed faster, close to the
+  /// waypoint, could not brake in time and would overshoot it.
+  double handback_stop_speed = 0.3;
 };
 
 /// The straight leg (world NED) the nominal guidance flies.
@@ -62,8 +66,10 @@ class AvoidanceSwitch {
   explicit AvoidanceSwitch(SwitchSettings settings = {}) : settings_(settings) {}
 
   /// One decision at `time` (s). conflict: the nominal path is too close to
-  /// an obstacle now. Returns whether avoidance is engaged after it.
-  bool update(double time, bool conflict, double cross_track);
+  /// an obstacle now. cross_track: the vehicle's distance from the leg (m).
+  /// stopping_speed: its speed while avoidance is stopping it at the last
+  /// waypoint, 0 otherwise. Returns whether avoidance is engaged after it.
+  bool update(double time, bool conflict, double cross_track, double stopping_speed = 0.0);
   bool engaged() const { return engaged_; }
   void reset() {
     engaged_ = false;

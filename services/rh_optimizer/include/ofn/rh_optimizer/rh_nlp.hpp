@@ -149,6 +149,7 @@ class RhNlp {
   Vec3 start_acceleration_ = Vec3::Zero();  // guidance
   Vec3 target_ = Vec3::Zero();              // guidance, relative to the start
   double terminal_x_ = 0;                   // guidance, relative to the start
+  bool stop_at_target_ = false;             // RhProblem::stop_at_target
   double max_speed_ = 1, max_vertical_speed_ = 1, max_accel_ = 1;
   double start_clearance_ = 0;
   bool has_clearance_ = false;

@@ -77,8 +77,11 @@ struct RhProblem {
   Vec3 acceleration = Vec3::Zero();  // m/s^2
   Vec3 target = Vec3::Zero();        // m, world NED (Eq. 1)
   double terminal_x = 0;             // m, guidance-frame x_f (Eq. 6)
-  Limits limits;                     // SI; limits.max_accel is every ellipse axis
-  ClearanceQuery clearance;          // empty: open space
+  /// The trajectory ends at rest at `target` (x_f is the target's x): the
+  /// last waypoint is within the horizon, and the vehicle stops there.
+  bool stop_at_target = false;
+  Limits limits;             // SI; limits.max_accel is every ellipse axis
+  ClearanceQuery clearance;  // empty: open space
 };
 
 /// Where a solve starts: positions (world NED) at equal time steps over

@@ -58,11 +58,14 @@ struct RhOptimizerServiceConfig {
   // with the global route that the new obstacle is about to produce.
   double defer_margin = 10.0;  // m
   mapping::DistanceFieldConfig field;
-  /// Flown with reserves on the speed and acceleration limits and a
-  /// smaller clearance margin than the core's plain defaults: measured on
-  /// the benchmark courses (README, "Planning and avoidance").
+  /// Flown with reserves on the speed and acceleration limits, a smaller
+  /// clearance margin than the core's plain defaults, and equal weights (Eq.
+  /// 1 becomes the squared distance to the target, so past an obstacle the
+  /// path heads for the waypoint instead of back to the leg first): measured
+  /// on the benchmark courses (README, "Planning and avoidance").
   RhSettings optimizer = [] {
     RhSettings s;
+    s.weights = Vec3(30.0, 30.0, 30.0);
     s.speed_margin = 0.01;
     s.accel_margin = 0.06;
     s.clearance_margin = 0.5;
@@ -132,6 +135,7 @@ class RhOptimizerService {
   bool route_changed_ = false;
   BsplineTrajectory last_trajectory_;  // last published, for a(t0)
   Utime last_trajectory_t0_ = 0;
+  bool stopping_at_target_ = false;  // the last plan stops at the last waypoint
   int64_t steps_ = 0;
   std::string last_note_;
 };
