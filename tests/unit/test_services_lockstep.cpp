@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ofn/actuator_cmd_t.hpp"
@@ -240,6 +242,92 @@ TEST_F(LockstepServices, ControllerCommandsLevelHoverWhenNavigationIsLost) {
   // Level hover: no cyclic.
   EXPECT_EQ(recorder.commands.back().lon_cyclic, 0.0);
   EXPECT_EQ(recorder.commands.back().lat_cyclic, 0.0);
+}
+
+/// Uplinks a mission and, from `from` seconds on, a fresh REF_TRAJ every
+/// 0.1 s: a straight line from the vehicle at a constant velocity.
+class TrajectoryFeeder {
+ public:
+  TrajectoryFeeder(sim::Lockstep& lockstep, mission_t mission, Vec3 position)
+      : node_("trajectory_feeder", lockstep.lcm(), lockstep.clock()),
+        mission_(std::move(mission)),
+        position_(position) {
+    node_.add_timer(
+        0.1, [this] { publish(); }, "traj");
+  }
+  Node& node() { return node_; }
+  Vec3 velocity = Vec3::Zero();
+  double from = 0;
+
+ private:
+  void publish() {
+    node_.publish(channels::kMission, mission_);
+    if (to_seconds(node_.now()) < from) return;
+    ref_traj_t m{};
+    m.utime = node_.now();
+    m.t0_utime = m.utime;
+    m.frame = "NED";
+    m.mode = ref_traj_t::AVOIDANCE;
+    m.num_samples = 2;
+    m.sample_time = {0.0, 1.0};
+    const Vec3 ahead = position_ + velocity;
+    m.position = {{position_.x(), position_.y(), position_.z()}, {ahead.x(), ahead.y(), ahead.z()}};
+    m.velocity = {{velocity.x(), velocity.y(), velocity.z()},
+                  {velocity.x(), velocity.y(), velocity.z()}};
+    m.acceleration = {{0, 0, 0}, {0, 0, 0}};
+    node_.publish(channels::kRefTraj, m);
+  }
+  Node node_;
+  mission_t mission_;
+  Vec3 position_;
+};
+
+TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
+  // The vehicle faces north (the leg); from 1 s a trajectory heads east. The
+  // heading turns at 30 deg/s, not in one step; a slow reference then holds
+  // it wherever that reference points.
+  sim::Lockstep lockstep;
+  const Scenario open = load_scenario(kOpenScenario);
+  const Vec3 here = open.waypoints.front().position;
+  NavFeeder nav(lockstep, here);
+  TrajectoryFeeder feeder(lockstep, uplink::mission_from_scenario(open, 1), here);
+  feeder.from = 1.0;
+  feeder.velocity = Vec3(0, 3, 0);
+  auto config = default_controller_config();
+  ASSERT_NEAR(rad2deg(config.heading.max_rate), 30.0, 1e-9);
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(), config);
+  BusRecorder recorder(lockstep);
+  for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})
+    lockstep.add(*n);
+  lockstep.run(to_utime(6.0));
+  feeder.velocity = Vec3(-0.5, -0.2, 0);  // slow, pointing elsewhere
+  lockstep.run(to_utime(9.0));
+
+  const auto yaw_at = [&](double t) {
+    for (const auto& s : recorder.status)
+      if (to_seconds(s.utime) >= t) return rad2deg(s.yaw_reference);
+    return std::numeric_limits<double>::quiet_NaN();
+  };
+  double turn_start = NAN;
+  for (const auto& s : recorder.status)
+    if (s.mode == control_status_t::TRAJECTORY) {
+      turn_start = to_seconds(s.utime);
+      break;
+    }
+  ASSERT_TRUE(std::isfinite(turn_start));
+  EXPECT_NEAR(yaw_at(turn_start - 0.1), 0.0, 1e-6);
+  EXPECT_NEAR(yaw_at(turn_start + 1.0), 30.0, 1.5);
+  EXPECT_NEAR(yaw_at(turn_start + 2.0), 60.0, 1.5);
+  EXPECT_NEAR(yaw_at(5.5), 90.0, 1e-6);
+  // Never faster than the limit between two status messages.
+  for (size_t i = 1; i < recorder.status.size(); ++i) {
+    const double dt = to_seconds(recorder.status[i].utime - recorder.status[i - 1].utime);
+    const double step =
+        std::abs(recorder.status[i].yaw_reference - recorder.status[i - 1].yaw_reference);
+    EXPECT_LE(step, config.heading.max_rate * dt + 1e-9) << "at " << i;
+  }
+  // Slow: the heading stays east.
+  EXPECT_NEAR(yaw_at(8.9), 90.0, 1e-6);
 }
 
 ref_traj_t three_sample_traj(Utime t0) {

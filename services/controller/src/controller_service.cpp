@@ -94,6 +94,11 @@ ControllerConfig load_controller_config(YamlReader& r) {
       deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
   c.sweep.scanner_timeout = sweep.number_in("scanner_timeout", c.sweep.scanner_timeout, 0.05, 60.0);
   sweep.finish();
+  YamlReader heading = r.child("path_heading");
+  c.heading.max_rate =
+      deg2rad(heading.number_in("max_rate_deg_s", rad2deg(c.heading.max_rate), 1.0, 360.0));
+  c.heading.min_speed = heading.number_in("min_speed", c.heading.min_speed, 0.0, 20.0);
+  heading.finish();
   YamlReader nominal = r.child("nominal_airframe");
   c.nominal.mass = nominal.number_in("mass", c.nominal.mass, 1.0, 1e4);
   nominal.finish();
@@ -156,14 +161,19 @@ void ControllerService::on_lidar_scan() {
   last_scan_ = node_.now();
 }
 
-double ControllerService::yaw_reference(const Vec3& leg_direction, double* yaw_rate) {
-  // Face along the path; hold the last heading while hovering.
-  if (std::hypot(leg_direction.x(), leg_direction.y()) > 0.2) {
-    path_yaw_ = std::atan2(leg_direction.y(), leg_direction.x());
-    path_yaw_set_ = true;
+double ControllerService::yaw_reference(const std::optional<Vec3>& facing, double dt,
+                                        double* yaw_rate) {
+  // Face along the path, turning at a bounded rate; hold the last heading
+  // while hovering or climbing straight up. The turn gives no yaw-rate
+  // feed-forward: the direction of a sampled reference jumps a little with
+  // every new REF_TRAJ, and its difference quotient would be noise.
+  *yaw_rate = 0;
+  if (facing) {
+    const double step = wrap_angle(std::atan2(facing->y(), facing->x()) - path_yaw_);
+    const double limit = config_.heading.max_rate * dt;
+    path_yaw_ = wrap_angle(path_yaw_ + std::clamp(step, -limit, limit));
   }
   double yaw = path_yaw_;
-  *yaw_rate = 0;
   const Utime now = node_.now();
   const bool scanner_on =
       last_scan_ != INT64_MIN && now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
@@ -184,7 +194,7 @@ double ControllerService::yaw_reference(const Vec3& leg_direction, double* yaw_r
     const double a = half * std::min(1.0, t / ramp);
     const double a_rate = t < ramp ? half / ramp : 0.0;
     yaw += a * std::sin(w * t);
-    *yaw_rate = a_rate * std::sin(w * t) + a * w * std::cos(w * t);
+    *yaw_rate += a_rate * std::sin(w * t) + a * w * std::cos(w * t);
   }
   return wrap_angle(yaw);
 }
@@ -239,7 +249,9 @@ void ControllerService::control_step() {
     traj_ref = sample_ref_traj(*ref_traj_, now);
 
   Reference ref;
-  Vec3 leg_direction = Vec3::Zero();
+  // The horizontal direction to face, if there is one.
+  std::optional<Vec3> facing;
+  const auto horizontal = [](const Vec3& v) { return std::hypot(v.x(), v.y()); };
   if (!guidance_.has_mission()) {
     if (previous != control_status_t::HOLD) hold_position_ = x.position;
     mode_ = control_status_t::HOLD;
@@ -247,7 +259,7 @@ void ControllerService::control_step() {
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;
-    leg_direction = ref.velocity;
+    if (horizontal(ref.velocity) > config_.heading.min_speed) facing = ref.velocity;
   } else {
     if (previous == control_status_t::TRAJECTORY) guidance_.resync(x.position, x.velocity);
     const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
@@ -255,14 +267,14 @@ void ControllerService::control_step() {
     ref.position = g.position;
     ref.velocity = g.velocity;
     ref.acceleration = g.acceleration;
-    leg_direction = g.leg_direction;
+    if (horizontal(g.leg_direction) > 0.2) facing = g.leg_direction;  // unit; not a vertical leg
     mode_ = g.done ? control_status_t::DONE : control_status_t::WAYPOINT;
   }
   if (previous == control_status_t::HOLD && mode_ != control_status_t::HOLD) controller_.reset();
   if (mode_ != previous)
     node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
                      static_cast<int>(mode_), to_seconds(now));
-  ref.yaw = yaw_reference(leg_direction, &ref.yaw_rate);
+  ref.yaw = yaw_reference(facing, dt, &ref.yaw_rate);
 
   last_ref_ = ref;
   last_out_ = controller_.step(ref, x, dt);

@@ -28,6 +28,15 @@ struct YawSweep {
   double scanner_timeout = 1.0;      // s without LIDAR_RAW after which the scanner counts as off
 };
 
+/// How the vehicle faces along its path. A trajectory's velocity turns fast
+/// when it is slow (a stop beside the waypoint turns it through tens of
+/// degrees in a second), and a mode or leg change steps the path direction:
+/// the heading follows at a bounded rate and holds below a speed.
+struct PathHeading {
+  double max_rate = deg2rad(30);  // rad/s the path heading turns at most
+  double min_speed = 1.0;         // m/s of reference velocity below which it holds
+};
+
 struct ControllerConfig {
   double rate = 100.0;            // Hz, control loop and ACTUATOR_CMD
   double status_rate = 50.0;      // Hz, CONTROL_STATUS
@@ -37,6 +46,7 @@ struct ControllerConfig {
   AdaptiveConfig adaptive;
   GuidanceConfig guidance;
   YawSweep sweep;
+  PathHeading heading;
   vehicle::RotorcraftParams nominal;  // the controller's model of the airframe
 };
 
@@ -67,7 +77,7 @@ class ControllerService {
   void on_lidar_scan();
   void control_step();
   void publish_status();
-  double yaw_reference(const Vec3& leg_direction, double* yaw_rate);
+  double yaw_reference(const std::optional<Vec3>& facing, double dt, double* yaw_rate);
 
   Node node_;
   ControllerConfig config_;
