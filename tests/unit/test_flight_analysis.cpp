@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "ofn/control_status_t.hpp"
@@ -158,6 +160,105 @@ TEST(AnalyseFlight, EmptyInputGivesAnEmptySummary) {
   EXPECT_EQ(s.max_speed, 0.0);
   EXPECT_FALSE(s.gate_to_gate.has_value());
   EXPECT_FALSE(s.crossed_finish);
+}
+
+// ---------------------------------------------------------------------------
+// The benchmark rule (judge_flight): each limit fails only beyond 2 %, the
+// clearance below 0.8 R_s, and every broken rule is named.
+
+Limits judged_limits() {
+  Limits l = limits();
+  l.clearance = 6.096;  // R_s 20 ft
+  return l;
+}
+
+/// A flight inside every limit that crossed the finish gate.
+FlightSummary clean_flight() {
+  FlightSummary s;
+  s.crossed_finish = true;
+  s.max_speed = 12.0;
+  s.max_vertical_speed = 2.0;
+  s.max_commanded_accel_fraction = 1.0;
+  s.min_forward_speed = 0.0;
+  return s;
+}
+
+bool names(const Verdict& v, const std::string& text) {
+  for (const auto& line : v.failures)
+    if (line.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(JudgeFlight, AFlightAtTheLimitsSucceeds) {
+  const Verdict v = judge_flight(clean_flight(), judged_limits(), 0.8 * 6.096, true);
+  EXPECT_TRUE(v.success);
+  EXPECT_TRUE(v.failures.empty());
+  // No obstacles and no gates: limits alone.
+  FlightSummary no_gate = clean_flight();
+  no_gate.crossed_finish = false;
+  EXPECT_TRUE(judge_flight(no_gate, judged_limits(), std::nullopt, false).success);
+}
+
+TEST(JudgeFlight, EachRuleFailsJustBeyondItsToleranceAndIsNamed) {
+  const Limits l = judged_limits();
+  struct Case {
+    std::string name;
+    void (*spoil)(FlightSummary&, const Limits&, bool beyond);
+    std::string named;
+  };
+  const std::vector<Case> cases = {
+      {"speed",
+       [](FlightSummary& s, const Limits& lim, bool beyond) {
+         s.max_speed = lim.max_speed * (beyond ? 1.021 : 1.019);
+       },
+       "speed (m/s) over"},
+      {"vertical speed",
+       [](FlightSummary& s, const Limits& lim, bool beyond) {
+         s.max_vertical_speed = lim.max_vertical_speed * (beyond ? 1.021 : 1.019);
+       },
+       "vertical speed"},
+      {"commanded acceleration",
+       [](FlightSummary& s, const Limits&, bool beyond) {
+         s.max_commanded_accel_fraction = beyond ? 1.021 : 1.019;
+       },
+       "commanded acceleration"},
+      {"backwards",
+       [](FlightSummary& s, const Limits& lim, bool beyond) {
+         s.min_forward_speed = -lim.max_speed * (beyond ? 0.021 : 0.019);
+       },
+       "forward speed"},
+  };
+  for (const Case& c : cases) {
+    FlightSummary inside = clean_flight();
+    c.spoil(inside, l, false);
+    EXPECT_TRUE(judge_flight(inside, l, 10.0, true).success) << c.name;
+    FlightSummary beyond = clean_flight();
+    c.spoil(beyond, l, true);
+    const Verdict v = judge_flight(beyond, l, 10.0, true);
+    EXPECT_FALSE(v.success) << c.name;
+    ASSERT_EQ(v.failures.size(), 1u) << c.name;
+    EXPECT_TRUE(names(v, c.named)) << c.name << ": " << v.failures.front();
+  }
+}
+
+TEST(JudgeFlight, ClearanceBelowEightTenthsOfRsAndAMissedGateFail) {
+  const Limits l = judged_limits();
+  // Inside R_s but not below 0.8 R_s: allowed.
+  EXPECT_TRUE(judge_flight(clean_flight(), l, 0.81 * l.clearance, true).success);
+  const Verdict close = judge_flight(clean_flight(), l, 0.79 * l.clearance, true);
+  EXPECT_FALSE(close.success);
+  EXPECT_TRUE(names(close, "clearance"));
+
+  FlightSummary short_run = clean_flight();
+  short_run.crossed_finish = false;
+  short_run.max_speed = 2.0 * l.max_speed;
+  const Verdict v = judge_flight(short_run, l, 0.5 * l.clearance, true);
+  EXPECT_FALSE(v.success);
+  // Every broken rule is reported, not only the first.
+  EXPECT_EQ(v.failures.size(), 3u);
+  EXPECT_TRUE(names(v, "missed the finish gate"));
+  EXPECT_TRUE(names(v, "clearance"));
+  EXPECT_TRUE(names(v, "speed (m/s) over"));
 }
 
 }  // namespace
