@@ -239,14 +239,21 @@ TEST(RhNlp, FitReproducesASplineGuessAndItsState) {
 
 // ---------------------------------------------------------------------------
 
-TEST(RhOptimizer, OpenSpaceFromAStraightGuess) {
-  const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
-  RhOptimizer optimizer;
+/// The open course's leg and limits, the target its last waypoint; the
+/// start state is the caller's.
+RhProblem open_course_problem(const Scenario& open) {
   RhProblem problem;
   problem.frame =
       GuidanceFrame::from_leg(open.waypoints.front().position, open.waypoints.back().position);
   problem.limits = open.limits;
   problem.target = open.waypoints.back().position;
+  return problem;
+}
+
+TEST(RhOptimizer, OpenSpaceFromAStraightGuess) {
+  const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
+  RhOptimizer optimizer;
+  RhProblem problem = open_course_problem(open);
   for (const double along : {0.0, 40.0, 90.0}) {
     problem.position = problem.frame.to_world(Vec3(along, 2.0, 0.0));
     problem.velocity = problem.frame.world_from_guidance.col(0) * open.cruise_speed;
@@ -264,11 +271,7 @@ TEST(RhOptimizer, StopsAtRestOnTheLastWaypoint) {
   // speed: the trajectory ends on the waypoint at rest, within the limits.
   const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
   RhOptimizer optimizer;
-  RhProblem problem;
-  problem.frame =
-      GuidanceFrame::from_leg(open.waypoints.front().position, open.waypoints.back().position);
-  problem.limits = open.limits;
-  problem.target = open.waypoints.back().position;
+  RhProblem problem = open_course_problem(open);
   problem.terminal_x = problem.frame.to_guidance(problem.target).x();
   problem.position = problem.frame.to_world(Vec3(problem.terminal_x - 40.0, 3.0, 0.0));
   problem.velocity = problem.frame.world_from_guidance.col(0) * open.cruise_speed;
