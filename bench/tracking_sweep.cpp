@@ -1,8 +1,10 @@
 // Tracking sweep: RMS and largest position error of the trajectory follower,
 // adaptive and non-adaptive, over a grid of airframe errors (mass, inertia,
 // actuator and rotor time constants) and crosswinds with Dryden turbulence,
-// on the no-obstacle course flown in-process. Writes a Markdown table and a
-// CSV (for plot_tracking_sweep.py) into the output folder.
+// on the no-obstacle course flown in-process, with the gains, adaptation and
+// guidance of a controller config file (by default the repository's). Writes
+// a Markdown table and a CSV (for plot_tracking_sweep.py) into the output
+// folder.
 
 #include <CLI/CLI.hpp>
 
@@ -12,7 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "ofn/common/config.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/controller/controller_service.hpp"
 #include "ofn/controller/tracking_flight.hpp"
 
 namespace {
@@ -29,10 +33,15 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn tracking sweep: adaptive vs non-adaptive tracking error"};
   std::string scenario_path = std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml";
   std::string out_dir = std::string(OFN_SOURCE_DIR) + "/results/bench";
+  std::string config_path = std::string(OFN_SOURCE_DIR) + "/config/controller.yaml";
   double duration = 240;
   std::string turbulence = "light";
   app.add_option("--scenario", scenario_path,
                  "course to fly (its own wind and errors are replaced)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--config", config_path,
+                 "controller config: gains, adaptation and guidance of the adaptive case; the "
+                 "non-adaptive case is the same with adaptation off")
       ->check(CLI::ExistingFile);
   app.add_option("--out", out_dir, "folder for tracking_sweep.md and tracking_sweep.csv");
   app.add_option("--duration", duration, "s of flight per case (the route is flown back and forth)")
@@ -41,7 +50,20 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"none", "light", "moderate", "severe"}));
   CLI11_PARSE(app, argc, argv);
 
-  const ofn::Scenario base = ofn::load_scenario(scenario_path);
+  ofn::Scenario base;
+  ofn::control::TrackingSetup tuned;
+  try {
+    base = ofn::load_scenario(scenario_path);
+    auto reader = ofn::YamlReader::load_file(config_path);
+    const auto controller = ofn::control::load_controller_config(reader);
+    tuned.gains = controller.gains;
+    tuned.adaptive = controller.adaptive;
+    tuned.guidance = controller.guidance;
+    tuned.nominal = controller.nominal;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ofn_tracking_sweep: %s\n", e.what());
+    return 2;
+  }
   const double kt = 1852.0 / 3600.0;
   const double w20 = turbulence == "light"      ? 15 * kt
                      : turbulence == "moderate" ? 30 * kt
@@ -57,7 +79,8 @@ int main(int argc, char** argv) {
   std::ofstream csv(out_dir + "/tracking_sweep.csv");
   csv << "mass_scale,airframe,wind_kt,turbulence,adaptive_rms,adaptive_max,baseline_rms,"
          "baseline_max\n";
-  md << "Tracking error (m, commanded minus true position) on `" << base.name << "`, " << duration
+  md << "Controller config `" << config_path << "`.\n\n"
+     << "Tracking error (m, commanded minus true position) on `" << base.name << "`, " << duration
      << " s per case flown back and forth, crosswind with " << turbulence
      << " Dryden turbulence (seeded), yaw sweep on.\n\n"
      << "| mass | inertia / time constants | wind | adaptive RMS | adaptive max | "
@@ -74,7 +97,7 @@ int main(int argc, char** argv) {
         s.vehicle.actuator_time_scale = airframe.time_scale;
         s.wind = ofn::Vec3(0, wind * kt, 0);  // across the northbound course
         s.disturbances.turbulence.wind_at_20ft = w20;
-        ofn::control::TrackingSetup adaptive, baseline;
+        ofn::control::TrackingSetup adaptive = tuned, baseline = tuned;
         baseline.adaptive.enabled = false;
         const auto a = ofn::control::fly_tracking(s, adaptive, config);
         const auto b = ofn::control::fly_tracking(s, baseline, config);
