@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
     tuned.adaptive = controller.adaptive;
     tuned.guidance = controller.guidance;
     tuned.nominal = controller.nominal;
+    tuned.heading = controller.heading;
+    tuned.sweep = controller.sweep;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ofn_tracking_sweep: %s\n", e.what());
     return 2;

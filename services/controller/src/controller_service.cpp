@@ -127,7 +127,8 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
     : node_("controller", lcm, clock),
       config_(std::move(config)),
       controller_(config_.nominal, config_.gains, make_adaptive_element(config_.adaptive)),
-      guidance_(config_.guidance) {
+      guidance_(config_.guidance),
+      path_heading_(config_.heading) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
       SubscribeOptions{config_.nav_timeout, 0.5});
@@ -163,17 +164,9 @@ void ControllerService::on_lidar_scan() {
 
 double ControllerService::yaw_reference(const std::optional<Vec3>& facing, double dt,
                                         double* yaw_rate) {
-  // Face along the path, turning at a bounded rate; hold the last heading
-  // while hovering or climbing straight up. The turn gives no yaw-rate
-  // feed-forward: the direction of a sampled reference jumps a little with
-  // every new REF_TRAJ, and its difference quotient would be noise.
+  // Face along the path; sweep the scanner while it runs.
   *yaw_rate = 0;
-  if (facing) {
-    const double step = wrap_angle(std::atan2(facing->y(), facing->x()) - path_yaw_);
-    const double limit = config_.heading.max_rate * dt;
-    path_yaw_ = wrap_angle(path_yaw_ + std::clamp(step, -limit, limit));
-  }
-  double yaw = path_yaw_;
+  double yaw = path_heading_.update(facing, dt);
   const Utime now = node_.now();
   const bool scanner_on =
       last_scan_ != INT64_MIN && now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
@@ -185,16 +178,7 @@ double ControllerService::yaw_reference(const std::optional<Vec3>& facing, doubl
       sweep_since_ = now;
       node_.log().info("scanner active: yaw sweep started");
     }
-    // yaw = a(t) * sin(w t) with the amplitude ramping linearly over one
-    // period from zero, so the commanded yaw and its rate start at zero.
-    const double w = 2.0 * kPi * config_.sweep.frequency;
-    const double t = to_seconds(now - sweep_since_);
-    const double ramp = 1.0 / config_.sweep.frequency;
-    const double half = 0.5 * config_.sweep.total_angle;
-    const double a = half * std::min(1.0, t / ramp);
-    const double a_rate = t < ramp ? half / ramp : 0.0;
-    yaw += a * std::sin(w * t);
-    *yaw_rate += a_rate * std::sin(w * t) + a * w * std::cos(w * t);
+    yaw += yaw_sweep_offset(config_.sweep, to_seconds(now - sweep_since_), yaw_rate);
   }
   return wrap_angle(yaw);
 }
@@ -232,10 +216,7 @@ void ControllerService::control_step() {
       Quat(nav_->quaternion[0], nav_->quaternion[1], nav_->quaternion[2], nav_->quaternion[3])
           .normalized();
   x.body_rates = to_vec3(nav_->body_rates);
-  if (!path_yaw_set_) {
-    path_yaw_ = nav_->euler[2];
-    path_yaw_set_ = true;
-  }
+  if (!path_heading_.initialised()) path_heading_.reset(nav_->euler[2]);
 
   if (mission_pending_) {
     guidance_.set_mission(waypoints_from(*mission_), mission_->cruise_speed,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "ofn/vehicle_sim/disturbances.hpp"
 
@@ -42,10 +43,10 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
       std::max(1, static_cast<int>(std::lround(config.physics_rate / config.control_rate)));
   const int steps = static_cast<int>(std::lround(config.duration / dt));
   const int trace_every = std::max(1, static_cast<int>(std::lround(config.trace_interval / dt)));
-  const double sweep_w = 2.0 * kPi * 0.2, sweep_half = deg2rad(20.0), sweep_ramp = 5.0;
 
   TrackingResult r;
-  double path_yaw = scenario.start_heading;
+  PathHeadingFilter path_heading(setup.heading);
+  path_heading.reset(scenario.start_heading);
   double sum_sq = 0, sum_sq_first = 0, sum_sq_second = 0;
   int n = 0, n_first = 0, n_second = 0;
   const double half_time = 0.5 * (config.duration + config.settle_time);
@@ -64,14 +65,12 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
     ref.position = g.position;
     ref.velocity = g.velocity;
     ref.acceleration = g.acceleration;
-    if (std::hypot(g.velocity.x(), g.velocity.y()) > 0.2)
-      path_yaw = std::atan2(g.velocity.y(), g.velocity.x());
-    ref.yaw = path_yaw;
-    if (config.yaw_sweep) {
-      const double a = sweep_half * std::min(1.0, t / sweep_ramp);
-      const double a_rate = t < sweep_ramp ? sweep_half / sweep_ramp : 0.0;
-      ref.yaw = wrap_angle(path_yaw + a * std::sin(sweep_w * t));
-      ref.yaw_rate = a_rate * std::sin(sweep_w * t) + a * sweep_w * std::cos(sweep_w * t);
+    // As the service: face the leg (not a vertical one), sweep on top.
+    std::optional<Vec3> facing;
+    if (std::hypot(g.leg_direction.x(), g.leg_direction.y()) > 0.2) facing = g.leg_direction;
+    ref.yaw = path_heading.update(facing, dt);
+    if (config.yaw_sweep && setup.sweep.enabled) {
+      ref.yaw = wrap_angle(ref.yaw + yaw_sweep_offset(setup.sweep, t, &ref.yaw_rate));
     }
 
     VehicleEstimate x;

@@ -8,6 +8,7 @@
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/controller/heading_reference.hpp"
 #include "ofn/controller/neural_adaptation.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
@@ -17,25 +18,6 @@
 #include "ofn/ref_traj_t.hpp"
 
 namespace ofn::control {
-
-/// Oscillatory yaw that sweeps the vertical scanner across the path (paper
-/// section 3.1). It runs only while LIDAR scans arrive, and fades in over one
-/// period so that the yaw rate never steps.
-struct YawSweep {
-  bool enabled = true;
-  double frequency = 0.2;            // Hz
-  double total_angle = deg2rad(40);  // rad, peak to peak
-  double scanner_timeout = 1.0;      // s without LIDAR_RAW after which the scanner counts as off
-};
-
-/// How the vehicle faces along its path. A trajectory's velocity turns fast
-/// when it is slow (a stop beside the waypoint turns it through tens of
-/// degrees in a second), and a mode or leg change steps the path direction:
-/// the heading follows at a bounded rate and holds below a speed.
-struct PathHeading {
-  double max_rate = deg2rad(30);  // rad/s the path heading turns at most
-  double min_speed = 1.0;         // m/s of reference velocity below which it holds
-};
 
 struct ControllerConfig {
   double rate = 100.0;            // Hz, control loop and ACTUATOR_CMD
@@ -89,8 +71,7 @@ class ControllerService {
   std::optional<ref_traj_t> ref_traj_;
   int8_t mode_ = control_status_t::NAV_STALE;  // until the first navigation arrives
   Vec3 hold_position_ = Vec3::Zero();
-  double path_yaw_ = 0;
-  bool path_yaw_set_ = false;
+  PathHeadingFilter path_heading_;
   int active_waypoint_ = -1;
   Reference last_ref_;
   ControlOutput last_out_;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ofn/common/scenario.hpp"
+#include "ofn/controller/heading_reference.hpp"
 #include "ofn/controller/neural_adaptation.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
@@ -20,7 +21,7 @@ struct TrackingFlightConfig {
   double control_rate = 100;  // Hz
   double physics_rate = 400;  // Hz
   bool round_trip = true;     // at the last waypoint, fly the route back, until `duration`
-  bool yaw_sweep = true;      // the scanner's yaw sweep (0.2 Hz, 40 deg peak to peak)
+  bool yaw_sweep = true;      // the scanner's yaw sweep (TrackingSetup::sweep)
   double settle_time = 5;     // s at the start left out of the error statistics
   double trace_interval = 1;  // s between samples of the traces
 };
@@ -44,6 +45,11 @@ struct TrackingSetup {
   ControllerGains gains;
   AdaptiveConfig adaptive;
   GuidanceConfig guidance;
+  // The heading as the controller service commands it: along the leg at a
+  // bounded turn rate (a route flown back turns it through 180 deg), with
+  // the yaw sweep over it.
+  PathHeading heading;
+  YawSweep sweep;
 };
 
 /// Flies the scenario's waypoints (steady wind, disturbances, airframe

@@ -1,0 +1,32 @@
+#include "ofn/controller/heading_reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ofn::control {
+
+void PathHeadingFilter::reset(double yaw) {
+  yaw_ = yaw;
+  initialised_ = true;
+}
+
+double PathHeadingFilter::update(const std::optional<Vec3>& facing, double dt) {
+  if (facing) {
+    const double step = wrap_angle(std::atan2(facing->y(), facing->x()) - yaw_);
+    const double limit = settings_.max_rate * dt;
+    yaw_ = wrap_angle(yaw_ + std::clamp(step, -limit, limit));
+  }
+  return yaw_;
+}
+
+double yaw_sweep_offset(const YawSweep& sweep, double t, double* rate) {
+  const double w = 2.0 * kPi * sweep.frequency;
+  const double ramp = 1.0 / sweep.frequency;
+  const double half = 0.5 * sweep.total_angle;
+  const double a = half * std::min(1.0, t / ramp);
+  const double a_rate = t < ramp ? half / ramp : 0.0;
+  *rate = a_rate * std::sin(w * t) + a * w * std::cos(w * t);
+  return a * std::sin(w * t);
+}
+
+}  // namespace ofn::control
