@@ -42,18 +42,6 @@ TrackingSetup setup_with(bool adaptive) {
   return s;
 }
 
-// The tuning for gusty air with an off-nominal airframe: the inner network
-// learning all the time and the slower attitude reference. The default tuning (dead zones,
-// 8 rad/s attitude reference) is for calm air, where it holds the speed
-// limit to 2 %; on this ten-minute windy course it tracks to tens of metres
-// (README, "Adaptive control").
-TrackingSetup gusty_setup_with(bool adaptive) {
-  TrackingSetup s = setup_with(adaptive);
-  s.adaptive.inner.dead_zone = 0.0;
-  s.gains.inner_reference_frequency = 5.0;
-  return s;
-}
-
 // One ten-minute flight each way, shared by the tests that read it.
 class WindyCourse : public ::testing::Test {
  protected:
@@ -61,8 +49,9 @@ class WindyCourse : public ::testing::Test {
     const Scenario scenario = load_scenario(kWindy);
     TrackingFlightConfig config;
     config.duration = 600;
-    adaptive_ = new TrackingResult(fly_tracking(scenario, gusty_setup_with(true), config));
-    baseline_ = new TrackingResult(fly_tracking(scenario, gusty_setup_with(false), config));
+    // The default tuning: the one the benchmark courses fly in calm air.
+    adaptive_ = new TrackingResult(fly_tracking(scenario, setup_with(true), config));
+    baseline_ = new TrackingResult(fly_tracking(scenario, setup_with(false), config));
   }
   static void TearDownTestSuite() {
     delete adaptive_;
