@@ -169,9 +169,8 @@ def write_report(args, runs, ctx):
         "- machine: %d cores, %s" % (ctx["machine"]["cores"], ctx["machine"]["cpu"]),
         "- commit: %s" % ctx["commit"],
         "- binaries: %s/bin, configuration %s" % (args.build, args.config_dir),
-        "- fields: seeds %d..%d (bench/random_field.py, course from %s), %d flown %d at a time"
-        % (args.seed_base, args.seed_base + args.runs - 1, os.path.relpath(ctx["template_path"], REPO), n,
-           args.jobs),
+        "- fields: seeds %s (bench/random_field.py, course from %s), %d flown %d at a time"
+        % (seeds_text(args.seeds), os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
         "- wall time: %.0f s in all, %.1f s per field (%.1f s per flight on one core); 1-minute "
         "load average %.1f before, %.1f after" % (ctx["wall_s"], ctx["wall_s"] / max(n, 1),
                                                   sum(r["wall_s"] for r in runs) / max(n, 1),
@@ -222,11 +221,19 @@ def write_report(args, runs, ctx):
     doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
            "runs": n, "successes": ok, "success_rate": rate, "wilson95": [lo, hi],
            "goal": SUCCESS_GOAL, "goal_met": rate >= SUCCESS_GOAL, "baselines_available": have_baseline,
-           "wall_s": ctx["wall_s"], "load_average": ctx["load"], "seed_base": args.seed_base,
+           "wall_s": ctx["wall_s"], "load_average": ctx["load"],
+           "seed_base": args.seed_base, "seeds": args.seeds,
            "results": runs}
     with open(os.path.join(args.out, "results.json"), "w") as f:
         json.dump(doc, f, indent=1)
     return rate
+
+
+def seeds_text(seeds):
+    """'1..300' for a run of consecutive seeds, else the list."""
+    if len(seeds) > 1 and seeds == list(range(seeds[0], seeds[-1] + 1)):
+        return "%d..%d" % (seeds[0], seeds[-1])
+    return ", ".join(str(s) for s in seeds)
 
 
 def median(values):
@@ -243,6 +250,8 @@ def parse_args(argv):
     ap.add_argument("--runs", type=int, default=None, help="number of fields (default 300)")
     ap.add_argument("--seed-base", "--seed", dest="seed_base", type=int, default=1,
                     help="seed of the first field; field i has seed S + i (default 1)")
+    ap.add_argument("--seeds", help="comma-separated seeds to fly, e.g. 64,131,257 (instead of "
+                    "--seed-base and --runs)")
     ap.add_argument("--jobs", type=int, default=2, help="flights at a time")
     ap.add_argument("--out", default=os.path.join(REPO, "results", "monte_carlo"))
     ap.add_argument("--config-dir", default=campaign.DEFAULT_CONFIG,
@@ -255,10 +264,22 @@ def parse_args(argv):
     ap.add_argument("--keep-all", action="store_true", help="keep every run's folder, log included")
     ap.add_argument("--quick", action="store_true", help="%d fields" % QUICK_RUNS)
     args = ap.parse_args(argv)
+    if args.seeds is not None:
+        try:
+            args.seeds = [int(v) for v in args.seeds.split(",") if v.strip()]
+        except ValueError:
+            ap.error("--seeds: expected comma-separated integers, got %r" % args.seeds)
+        if not args.seeds:
+            ap.error("--seeds: no seed given")
+        if len(set(args.seeds)) != len(args.seeds):
+            ap.error("--seeds: a seed is given twice")
+        args.runs = len(args.seeds)
     if args.runs is None:
         args.runs = QUICK_RUNS if args.quick else 300
     if args.runs < 1 or args.jobs < 1:
         ap.error("--runs and --jobs must be >= 1")
+    if args.seeds is None:
+        args.seeds = list(range(args.seed_base, args.seed_base + args.runs))
     args.build = os.path.abspath(args.build)
     args.out = os.path.abspath(args.out)
     args.config_dir = os.path.abspath(args.config_dir)
@@ -276,9 +297,9 @@ def main(argv=None):
         if sub != "fields" and os.path.isdir(path):
             shutil.rmtree(path)  # results of an earlier campaign must not mix in
         os.makedirs(path, exist_ok=True)
-    seeds = list(range(args.seed_base, args.seed_base + args.runs))
-    print("monte_carlo: %d fields (seeds %d..%d), %d at a time; binaries %s/bin; results in %s"
-          % (len(seeds), seeds[0], seeds[-1], args.jobs, args.build, args.out), flush=True)
+    seeds = args.seeds
+    print("monte_carlo: %d fields (seeds %s), %d at a time; binaries %s/bin; results in %s"
+          % (len(seeds), seeds_text(seeds), args.jobs, args.build, args.out), flush=True)
     if not os.access(campaign.bin_path(args.build, "ofn_baseline"), os.X_OK):
         print("monte_carlo: no ofn_baseline in %s/bin: baselines and ratios will read n/a" % args.build,
               flush=True)
