@@ -32,7 +32,7 @@ struct NetworkSettings {
 struct AdaptiveConfig {
   bool enabled = true;  // false: the non-adaptive baseline (reference models and hedging stay)
   NetworkSettings outer{8, 4.0, 1.0, 0.05, 20.0, 5.0, 0.5};       // outputs m/s^2
-  NetworkSettings inner{8, 50.0, 20.0, 0.005, 50.0, 20.0, 0.1};  // outputs rad/s^2
+  NetworkSettings inner{8, 100.0, 20.0, 0.005, 50.0, 20.0, 0.2};  // outputs rad/s^2
   uint32_t seed = 7;                                               // initial hidden-layer weights
 };
 
