@@ -33,7 +33,7 @@ struct AdaptiveConfig {
   bool enabled = true;  // false: the non-adaptive baseline (reference models and hedging stay)
   NetworkSettings outer{8, 4.0, 1.0, 0.05, 20.0, 5.0, 0.5};       // outputs m/s^2
   NetworkSettings inner{8, 100.0, 20.0, 0.005, 50.0, 20.0, 0.2};  // outputs rad/s^2
-  uint32_t seed = 7;                                               // initial hidden-layer weights
+  uint32_t seed = 7;                                              // initial hidden-layer weights
 };
 
 /// One single-hidden-layer network: nu = W^T sigma(V^T x_bar), x_bar and
