@@ -50,6 +50,15 @@ TEST(PathHeading, HoldsWithNothingToFace) {
   for (int i = 0; i < 100; ++i) EXPECT_DOUBLE_EQ(heading.update(std::nullopt, kDt), 0.4);
 }
 
+TEST(PathHeading, NothingToFaceAlongAVerticalLegOrASlowReference) {
+  EXPECT_FALSE(facing_along(Vec3(0.1, 0.0, -0.995), kMinLegHorizontal));  // climbing leg
+  EXPECT_TRUE(facing_along(Vec3(0.6, 0.0, -0.8), kMinLegHorizontal));
+  EXPECT_FALSE(facing_along(Vec3(0.5, 0.5, 0.0), 1.0));  // 0.7 m/s, below min_speed
+  const auto fast = facing_along(Vec3(3.0, -4.0, 0.0), 1.0);
+  ASSERT_TRUE(fast);
+  EXPECT_EQ(*fast, Vec3(3.0, -4.0, 0.0));
+}
+
 TEST(YawSweepOffset, StartsAtRestAndReachesTheFullSweepAfterOnePeriod) {
   YawSweep sweep;
   sweep.frequency = 0.2;

@@ -232,7 +232,6 @@ void ControllerService::control_step() {
   Reference ref;
   // The horizontal direction to face, if there is one.
   std::optional<Vec3> facing;
-  const auto horizontal = [](const Vec3& v) { return std::hypot(v.x(), v.y()); };
   if (!guidance_.has_mission()) {
     if (previous != control_status_t::HOLD) hold_position_ = x.position;
     mode_ = control_status_t::HOLD;
@@ -240,7 +239,7 @@ void ControllerService::control_step() {
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;
-    if (horizontal(ref.velocity) > config_.heading.min_speed) facing = ref.velocity;
+    facing = facing_along(ref.velocity, config_.heading.min_speed);
   } else {
     if (previous == control_status_t::TRAJECTORY) guidance_.resync(x.position, x.velocity);
     const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
@@ -248,7 +247,7 @@ void ControllerService::control_step() {
     ref.position = g.position;
     ref.velocity = g.velocity;
     ref.acceleration = g.acceleration;
-    if (horizontal(g.leg_direction) > 0.2) facing = g.leg_direction;  // unit; not a vertical leg
+    facing = facing_along(g.leg_direction, kMinLegHorizontal);
     mode_ = g.done ? control_status_t::DONE : control_status_t::WAYPOINT;
   }
   if (previous == control_status_t::HOLD && mode_ != control_status_t::HOLD) controller_.reset();

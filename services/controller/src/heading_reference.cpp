@@ -19,6 +19,11 @@ double PathHeadingFilter::update(const std::optional<Vec3>& facing, double dt) {
   return yaw_;
 }
 
+std::optional<Vec3> facing_along(const Vec3& direction, double min_horizontal) {
+  if (std::hypot(direction.x(), direction.y()) > min_horizontal) return direction;
+  return std::nullopt;
+}
+
 double yaw_sweep_offset(const YawSweep& sweep, double t, double* rate) {
   const double w = 2.0 * kPi * sweep.frequency;
   const double ramp = 1.0 / sweep.frequency;

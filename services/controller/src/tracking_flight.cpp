@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 
 #include "ofn/vehicle_sim/disturbances.hpp"
 
@@ -66,9 +65,7 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
     ref.velocity = g.velocity;
     ref.acceleration = g.acceleration;
     // As the service: face the leg (not a vertical one), sweep on top.
-    std::optional<Vec3> facing;
-    if (std::hypot(g.leg_direction.x(), g.leg_direction.y()) > 0.2) facing = g.leg_direction;
-    ref.yaw = path_heading.update(facing, dt);
+    ref.yaw = path_heading.update(facing_along(g.leg_direction, kMinLegHorizontal), dt);
     if (config.yaw_sweep && setup.sweep.enabled) {
       ref.yaw = wrap_angle(ref.yaw + yaw_sweep_offset(setup.sweep, t, &ref.yaw_rate));
     }

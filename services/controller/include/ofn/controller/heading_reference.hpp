@@ -54,6 +54,15 @@ class PathHeadingFilter {
   bool initialised_ = false;
 };
 
+/// A unit leg direction whose horizontal part is shorter than this is a
+/// (nearly) vertical leg: there is no direction along it to face.
+constexpr double kMinLegHorizontal = 0.2;
+
+/// `direction` as the one to face when its horizontal part is longer than
+/// `min_horizontal`, else none (the heading holds): a vertical leg, or a
+/// reference velocity too slow to point anywhere.
+std::optional<Vec3> facing_along(const Vec3& direction, double min_horizontal);
+
 /// The sweep's yaw offset `t` seconds after it started: a(t) sin(w t) with
 /// the amplitude a ramping linearly from zero over one period, so that the
 /// commanded yaw and its rate start at zero. `rate` receives its derivative.
