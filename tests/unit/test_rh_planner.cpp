@@ -92,6 +92,49 @@ TEST(RhPlanner, SolvesACleanProblemAndWarmStartsTheNext) {
   EXPECT_FALSE(planner.has_previous());
 }
 
+// Quadratic B-splines over `duration` seconds through four control points.
+BsplineTrajectory quadratic(const std::vector<Vec3>& points, double duration) {
+  return BsplineTrajectory(2, {0, 0, 0, 0.5, 1, 1, 1}, points, duration);
+}
+
+TEST(RhPlanner, APlanThatWaitsBeforeItMovesOffIsAStall) {
+  const Vec3 start(0, 0, -kAltitude);
+  const Vec3 far(60, 30, -kAltitude);
+  RhProblem problem = input_at(start, 0.0, field_with({})).problem;
+  problem.velocity = Vec3::Zero();
+  // Hovers for the first half (three coincident points), then goes 67 m.
+  const BsplineTrajectory waits = quadratic({start, start, start, far}, 20.0);
+  EXPECT_TRUE(plan_stalled(waits, problem));
+  // Moves off at once: no stall, however slow the vehicle is now.
+  const BsplineTrajectory goes =
+      quadratic({start, start + (far - start) / 3, start + 2 * (far - start) / 3, far}, 20.0);
+  EXPECT_FALSE(plan_stalled(goes, problem));
+  // A stop at the last waypoint ends near its start: not a stall.
+  const Vec3 near = start + Vec3(5, 0, 0);
+  EXPECT_FALSE(plan_stalled(quadratic({start, start, start, near}, 20.0), problem));
+  // The vehicle itself still moving: not a stall either (the plan brakes).
+  problem.velocity = Vec3(kLimits.max_speed, 0, 0);
+  EXPECT_FALSE(plan_stalled(waits, problem));
+}
+
+TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
+  // From a hover, the plan moves off at once, so the stall retry stays out
+  // of the way: one solve per step.
+  RhPlanner planner;
+  StepInput first = input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({}));
+  first.problem.velocity = Vec3::Zero();
+  const StepOutput out = planner.step(first);
+  ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
+  EXPECT_FALSE(plan_stalled(out.trajectory, first.problem));
+  StepInput second = input_at(out.trajectory.position(0.1), 0.1, field_with({}));
+  second.problem.velocity = out.trajectory.velocity(0.1);
+  second.problem.acceleration = out.trajectory.acceleration(0.1);
+  const StepOutput next = planner.step(second);
+  ASSERT_EQ(next.mode, StepMode::kSolved) << next.reason;
+  EXPECT_TRUE(next.report.warm_started);
+  EXPECT_EQ(next.solves, 1);
+}
+
 TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {
   RhPlanner planner;
   const ClearanceQuery open = field_with({});

@@ -117,6 +117,7 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   b.braking_accel_fraction =
       f.number_in("braking_accel_fraction", b.braking_accel_fraction, 0.05, 1.0);
   b.cold_retry = f.boolean("cold_retry", b.cold_retry);
+  b.stall_retry = f.boolean("stall_retry", b.stall_retry);
   f.finish();
 
   YamlReader a = r.child("avoidance");

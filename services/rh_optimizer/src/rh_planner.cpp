@@ -20,6 +20,15 @@ bool trajectory_finite(const BsplineTrajectory& trajectory) {
 
 }  // namespace
 
+bool plan_stalled(const BsplineTrajectory& trajectory, const RhProblem& problem) {
+  if (trajectory.empty() || trajectory.duration() <= kStallLookAhead) return false;
+  const double slow = std::min(kStallSpeedFraction * problem.limits.max_speed,
+                               0.25 * problem.limits.max_accel * kStallLookAhead);
+  const Vec3 start = trajectory.position(0.0);
+  return problem.velocity.norm() < slow && trajectory.velocity(kStallLookAhead).norm() < slow &&
+         (trajectory.position(trajectory.duration()) - start).norm() > kStallMinDisplacement;
+}
+
 const char* to_string(StepMode mode) {
   switch (mode) {
     case StepMode::kSolved:
@@ -104,6 +113,11 @@ StepOutput RhPlanner::step(const StepInput& input) {
   if (!out.report.feasible && guess.warm && fallback_.cold_retry) {
     out.report = optimizer_.solve(problem, cold_guess());
     out.solves = 2;
+  } else if (out.report.feasible && guess.warm && fallback_.stall_retry &&
+             plan_stalled(out.report.trajectory, problem)) {
+    SolveReport cold = optimizer_.solve(problem, cold_guess());
+    out.solves = 2;
+    if (cold.feasible && cold.cost < out.report.cost) out.report = std::move(cold);
   }
 
   if (out.report.feasible && trajectory_finite(out.report.trajectory)) {

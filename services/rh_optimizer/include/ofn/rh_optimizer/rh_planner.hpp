@@ -18,7 +18,24 @@ struct FallbackSettings {
   double keep_min_remaining = 2.0;      // s a kept trajectory must still run
   double braking_accel_fraction = 0.8;  // of limits.max_accel used to brake
   bool cold_retry = true;               // after a failed warm solve, try once from the path
+  bool stall_retry = true;  // a stalled warm plan: also solve from the path, fly the cheaper
 };
+
+/// A stall: the vehicle is slow (below kStallSpeedFraction of the speed
+/// limit) and so is the plan kStallLookAhead seconds on, yet the plan goes
+/// more than kStallMinDisplacement metres. A warm start inherits its
+/// predecessor's shape, so a plan that waits before it moves off is re-made
+/// from its own first instants at every step and the vehicle never leaves
+/// (seen in front of obstacles it had not yet seen round). The look-ahead is
+/// long enough for a start from rest under the benchmarks' limits (1.6
+/// ft/s^2 through the 0.5 s acceleration lag reaches 1.1 m/s in 3 s, against
+/// 0.3 m/s for "slow"); the speed threshold is capped at a quarter of what
+/// the acceleration limit reaches in that time for weaker limits. A plan
+/// that ends near its start (a stop at the last waypoint) is not a stall.
+constexpr double kStallLookAhead = 3.0;         // s
+constexpr double kStallSpeedFraction = 0.1;     // of limits.max_speed
+constexpr double kStallMinDisplacement = 10.0;  // m
+bool plan_stalled(const BsplineTrajectory& trajectory, const RhProblem& problem);
 
 enum class StepMode { kSolved, kKeptPrevious, kBraking };
 
