@@ -53,7 +53,7 @@ struct StepOutput {
   BsplineTrajectory trajectory;  // world NED
   double start_time = 0;         // s, clock time of the trajectory's t = 0
   SolveReport report;            // the last solve of this step (iterations 0 if none ran)
-  int solves = 0;                // solves run this step (a cold retry makes 2)
+  int solves = 0;                // solves run this step (a cold or stall retry makes 2)
   std::string reason;            // why a fallback was taken
 };
 
