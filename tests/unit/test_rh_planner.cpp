@@ -133,6 +133,8 @@ TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
   ASSERT_EQ(next.mode, StepMode::kSolved) << next.reason;
   EXPECT_TRUE(next.report.warm_started);
   EXPECT_EQ(next.solves, 1);
+  EXPECT_FALSE(next.stalled);
+  EXPECT_TRUE(next.reason.empty()) << next.reason;
 }
 
 TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {

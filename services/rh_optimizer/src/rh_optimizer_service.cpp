@@ -485,6 +485,9 @@ void RhOptimizerService::tick() {
   if (out.mode != StepMode::kSolved)
     node_.log().warn("t={:.2f} s {} ({} solves, worst violation {:.3g})", t, message, out.solves,
                      out.report.max_violation);
+  else if (out.stalled != stalled_)
+    node_.log().info("t={:.2f} s {}", t, out.stalled ? message : "no longer stalled");
+  stalled_ = out.stalled;
   note(std::string("avoiding: ") + to_string(out.mode));
   publish_stats(now, stats_status(out.mode), message, &out.report);
 }

@@ -117,7 +117,13 @@ StepOutput RhPlanner::step(const StepInput& input) {
              plan_stalled(out.report.trajectory, problem)) {
     SolveReport cold = optimizer_.solve(problem, cold_guess());
     out.solves = 2;
-    if (cold.feasible && cold.cost < out.report.cost) out.report = std::move(cold);
+    out.stalled = true;
+    if (cold.feasible && cold.cost < out.report.cost) {
+      out.report = std::move(cold);
+      out.reason = "warm plan stalled; the plan from the route is cheaper";
+    } else {
+      out.reason = "warm plan stalled; the plan from the route is no better";
+    }
   }
 
   if (out.report.feasible && trajectory_finite(out.report.trajectory)) {

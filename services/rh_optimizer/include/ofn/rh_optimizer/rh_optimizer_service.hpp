@@ -136,6 +136,7 @@ class RhOptimizerService {
   BsplineTrajectory last_trajectory_;  // last published, for a(t0)
   Utime last_trajectory_t0_ = 0;
   bool stopping_at_target_ = false;  // the last plan stops at the last waypoint
+  bool stalled_ = false;             // the last step's warm plan was a stall (logged once)
   int64_t steps_ = 0;
   std::string last_note_;
 };

@@ -54,7 +54,8 @@ struct StepOutput {
   double start_time = 0;         // s, clock time of the trajectory's t = 0
   SolveReport report;            // the last solve of this step (iterations 0 if none ran)
   int solves = 0;                // solves run this step (a cold or stall retry makes 2)
-  std::string reason;            // why a fallback was taken
+  std::string reason;            // why a fallback was taken, or what the stall retry did
+  bool stalled = false;          // the warm plan was a stall (plan_stalled) and was retried
 };
 
 class RhPlanner {
