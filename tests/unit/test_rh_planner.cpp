@@ -53,6 +53,14 @@ StepInput input_at(const Vec3& position, double time, ClearanceQuery clearance) 
   return input;
 }
 
+// The next step's input: the state `out` planned 0.1 s on, at `time`.
+StepInput one_step_on(const StepOutput& out, double time) {
+  StepInput next = input_at(out.trajectory.position(0.1), time, field_with({}));
+  next.problem.velocity = out.trajectory.velocity(0.1);
+  next.problem.acceleration = out.trajectory.acceleration(0.1);
+  return next;
+}
+
 bool finite(const BsplineTrajectory& trajectory) {
   if (trajectory.empty() || !std::isfinite(trajectory.duration())) return false;
   for (const Vec3& c : trajectory.control_points())
@@ -71,9 +79,7 @@ TEST(RhPlanner, SolvesACleanProblemAndWarmStartsTheNext) {
   EXPECT_FALSE(out.report.warm_started);
   EXPECT_TRUE(planner.has_previous());
 
-  StepInput second = input_at(out.trajectory.position(0.1), 10.1, field_with({}));
-  second.problem.velocity = out.trajectory.velocity(0.1);
-  second.problem.acceleration = out.trajectory.acceleration(0.1);
+  const StepInput second = one_step_on(out, 10.1);
   const StepOutput next = planner.step(second);
   ASSERT_EQ(next.mode, StepMode::kSolved) << next.reason;
   EXPECT_TRUE(next.report.warm_started);
@@ -126,10 +132,7 @@ TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
   const StepOutput out = planner.step(first);
   ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
   EXPECT_FALSE(plan_stalled(out.trajectory, first.problem));
-  StepInput second = input_at(out.trajectory.position(0.1), 0.1, field_with({}));
-  second.problem.velocity = out.trajectory.velocity(0.1);
-  second.problem.acceleration = out.trajectory.acceleration(0.1);
-  const StepOutput next = planner.step(second);
+  const StepOutput next = planner.step(one_step_on(out, 0.1));
   ASSERT_EQ(next.mode, StepMode::kSolved) << next.reason;
   EXPECT_TRUE(next.report.warm_started);
   EXPECT_EQ(next.solves, 1);
