@@ -246,6 +246,22 @@ TEST_F(ConfigFiles, ControllerConfigNegativeGainIsAnError) {
   }
 }
 
+TEST_F(ConfigFiles, NumbersInRangeReadOrNameTheFieldAndTheValue) {
+  const std::string path =
+      write("list.yaml", "good: [0.5, 1, 2]\nbad: [0.5, 7, 2]\nshort: [1, 2]\n");
+  auto reader = YamlReader::load_file(path);
+  EXPECT_EQ(reader.numbers_in("good", {0, 0, 0}, 0.0, 5.0), (std::vector<double>{0.5, 1, 2}));
+  EXPECT_EQ(reader.numbers_in("absent", {1, 2, 3}, 0.0, 5.0), (std::vector<double>{1, 2, 3}));
+  try {
+    reader.numbers_in("bad", {0, 0, 0}, 0.0, 5.0);
+    FAIL() << "accepted 7 in [0, 5]";
+  } catch (const ConfigError& e) {
+    EXPECT_NAMES(std::string(e.what()), path, "bad");
+    EXPECT_NE(std::string(e.what()).find("got 7"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(reader.numbers_in("short", {0, 0, 0}, 0.0, 5.0), ConfigError);
+}
+
 TEST_F(ConfigFiles, ControllerConfigReadsGains) {
   const std::string path = write("controller.yaml",
                                  "rate_hz: 50\nouter_loop:\n  position_gain: [0.5, 0.6, 0.7]\n"

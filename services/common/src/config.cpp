@@ -109,6 +109,19 @@ std::string YamlReader::text(const std::string& key) {
   return text(key, "");
 }
 
+std::vector<double> YamlReader::numbers_in(const std::string& key,
+                                           const std::vector<double>& fallback, double lo,
+                                           double hi) {
+  std::vector<double> v = numbers(key, fallback);
+  for (double x : v)
+    if (!(x >= lo && x <= hi)) {
+      std::ostringstream s;
+      s << "expected every number in [" << lo << ", " << hi << "], got " << x;
+      fail(key, s.str());
+    }
+  return v;
+}
+
 std::vector<double> YamlReader::numbers(const std::string& key, size_t size) {
   used_.insert(key);
   YAML::Node n = node_[key];

@@ -77,9 +77,7 @@ ObstacleSpec read_obstacle(YamlReader& o, size_t index, double metres_per_unit) 
 void read_vehicle(YamlReader& v, Scenario& s) {
   VehicleVariation& out = s.vehicle;
   out.mass_scale = v.number_in("mass_scale", 1.0, 0.2, 5.0);
-  const auto inertia = v.numbers("inertia_scale", {1.0, 1.0, 1.0});
-  for (double i : inertia)
-    if (!(i >= 0.2 && i <= 5.0)) v.fail("inertia_scale", "every scale must lie in [0.2, 5]");
+  const auto inertia = v.numbers_in("inertia_scale", {1.0, 1.0, 1.0}, 0.2, 5.0);
   out.inertia_scale = Vec3(inertia[0], inertia[1], inertia[2]);
   out.actuator_time_scale = v.number_in("actuator_time_scale", 1.0, 0.2, 10.0);
   YamlReader lim = v.child("actuator_limits");

@@ -1,5 +1,7 @@
 #include "ofn/controller/controller_service.hpp"
 
+#include <limits>
+
 #include "ofn/actuator_cmd_t.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/mission_plan.hpp"
@@ -14,11 +16,10 @@ Vec3 vec(const std::vector<double>& a) {
 void put(double (&dst)[3], const Vec3& v) {
   for (int i = 0; i < 3; ++i) dst[i] = v[i];
 }
+// Gains per axis: three numbers, none negative.
 Vec3 read_vec3(YamlReader& r, const std::string& key, const Vec3& fallback) {
-  const auto v = r.numbers(key, {fallback.x(), fallback.y(), fallback.z()});
-  for (double x : v)
-    if (x < 0) r.fail(key, "gains must be >= 0");
-  return vec(v);
+  return vec(r.numbers_in(key, {fallback.x(), fallback.y(), fallback.z()}, 0.0,
+                          std::numeric_limits<double>::infinity()));
 }
 
 }  // namespace

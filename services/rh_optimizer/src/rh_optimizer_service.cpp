@@ -10,10 +10,8 @@ namespace ofn::rh {
 namespace {
 
 Vec3 vec3_in(YamlReader& r, const std::string& key, const Vec3& fallback, double lo, double hi) {
-  const std::vector<double> v = r.numbers(key, {fallback.x(), fallback.y(), fallback.z()});
-  if (v.size() != 3) r.fail(key, "expected three numbers [x, y, z]");
-  for (double x : v)
-    if (!(x >= lo && x <= hi)) r.fail(key, "each value must be within the allowed range");
+  const std::vector<double> v =
+      r.numbers_in(key, {fallback.x(), fallback.y(), fallback.z()}, lo, hi);
   return Vec3(v[0], v[1], v[2]);
 }
 

@@ -69,9 +69,8 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
   YamlReader airframe = r.child("airframe");
   auto& p = c.params;
   p.mass = airframe.number_in("mass", p.mass, 1.0, 1e4);
-  const auto inertia = airframe.numbers("inertia", {p.inertia.x(), p.inertia.y(), p.inertia.z()});
-  for (double i : inertia)
-    if (i <= 0) airframe.fail("inertia", "every moment of inertia must be > 0");
+  const auto inertia =
+      airframe.numbers_in("inertia", {p.inertia.x(), p.inertia.y(), p.inertia.z()}, 1e-3, 1e5);
   p.inertia = Vec3(inertia[0], inertia[1], inertia[2]);
   p.flap_time_constant = airframe.number_in("flap_time_constant", p.flap_time_constant, 0.01, 2.0);
   p.inflow_time_constant =

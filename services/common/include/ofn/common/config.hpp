@@ -40,6 +40,9 @@ class YamlReader {
   /// A required or optional list of exactly `size` numbers.
   std::vector<double> numbers(const std::string& key, size_t size);
   std::vector<double> numbers(const std::string& key, const std::vector<double>& fallback);
+  /// An optional list as long as `fallback`, each number in [lo, hi].
+  std::vector<double> numbers_in(const std::string& key, const std::vector<double>& fallback,
+                                 double lo, double hi);
 
   /// A nested mapping; an absent one reads as empty.
   YamlReader child(const std::string& key);
