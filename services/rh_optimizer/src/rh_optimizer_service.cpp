@@ -228,6 +228,7 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   planner_.reset();
   switch_.reset();
   stopping_at_target_ = false;
+  stalled_ = false;
   visibility_.clear();
   shadows_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
@@ -331,6 +332,7 @@ void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& 
   planner_.reset();
   last_trajectory_ = BsplineTrajectory();
   stopping_at_target_ = false;
+  stalled_ = false;
   node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
                    why);
 }
