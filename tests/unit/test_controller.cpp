@@ -183,6 +183,35 @@ TEST(TrajectoryController, FollowsAConstantVelocityReferenceWithFeedForward) {
   EXPECT_NEAR(loop.state().velocity.x(), 3.0, 0.2);
 }
 
+TEST(TrajectoryController, YawSweepInCruiseBarelyMovesTheSpeed) {
+  // The scanner's yaw sweep (20 deg either way at 0.2 Hz) turns the tilted
+  // disk about the vertical. Unless that turn is fed forward as body rates,
+  // the attitude lags it and the flown speed swings with the yaw rate, which
+  // is what the cruise's speed reserve has to cover.
+  ClosedLoop loop;
+  Reference ref;
+  const double cruise = 3.0, amplitude = deg2rad(20), w = 2.0 * kPi * 0.2;
+  double s = 0, v = 0, slowest = 1e9, fastest = 0;
+  for (int i = 0; i < 6000; ++i) {
+    const double t = i * kControlDt;
+    const double a = v < cruise ? 0.5 : 0.0;
+    v = std::min(cruise, v + a * kControlDt);
+    s += v * kControlDt;
+    ref.position = Vec3(s, 0, 0);
+    ref.velocity = Vec3(v, 0, 0);
+    ref.acceleration = Vec3(a, 0, 0);
+    ref.yaw = amplitude * std::sin(w * t);
+    ref.yaw_rate = amplitude * w * std::cos(w * t);
+    ASSERT_TRUE(loop.step(ref).valid);
+    if (t > 40.0) {
+      const double speed = loop.state().velocity.norm();
+      slowest = std::min(slowest, speed);
+      fastest = std::max(fastest, speed);
+    }
+  }
+  EXPECT_LT(fastest - slowest, 0.01 * cruise) << "speeds " << slowest << " to " << fastest;
+}
+
 TEST(TrajectoryController, NaNPositionGivesSafeFiniteControls) {
   TrajectoryController controller{RotorcraftParams{}};
   const RotorcraftParams p;

@@ -178,7 +178,11 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
     return Vec3(2.0 * e.vec());
   };
   const double wi = g.inner_reference_frequency;
-  const Vec3 rate_command = Vec3(0, 0, ref.yaw_rate);
+  // The heading turns about the world's vertical; with the disk tilted that
+  // is partly a roll and pitch rate in body axes. Leaving those out made the
+  // reference attitude lag the command by 2 zeta / w_i under the yaw sweep,
+  // and the lagging tilt swung the flown speed.
+  const Vec3 rate_command = r_des.transpose() * Vec3(0, 0, ref.yaw_rate);
   const Vec3 rm_angular = wi * wi * rotation_error(ref_attitude_, out.attitude_command) +
                           2.0 * g.inner_reference_damping * wi * (rate_command - ref_rates_);
   ad.attitude_error = rotation_error(x.attitude, ref_attitude_);
