@@ -161,10 +161,28 @@ TEST(WaypointGuidance, RestartMidLegPicksUpTheLegTheVehicleIsOn) {
   const GuidanceReference r = g.update(position, velocity, kDt);
   EXPECT_EQ(r.active_waypoint, 2);
   // No jump: the reference starts at the vehicle's projection on the leg,
-  // moving at the vehicle's speed along it.
-  EXPECT_LT((r.position - Vec3(50, 24, -30)).norm(), 0.1);
+  // not a step ahead of it, moving at the vehicle's speed along it.
+  EXPECT_LT((r.position - Vec3(50, 24, -30)).norm(), 1e-9);
   EXPECT_NEAR(r.velocity.y(), 3.0, 0.05);
   EXPECT_TRUE(r.leg_direction.isApprox(Vec3::UnitY()));
+}
+
+TEST(WaypointGuidance, ResyncStartsOnTheVehicleThenAdvances) {
+  // After an avoidance hands back, the reference must restart where the
+  // vehicle is: one that starts a step ahead pulls a vehicle already at the
+  // speed limit past it.
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(200, 0, -30), 2.0}};
+  WaypointGuidance g;
+  g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), wps[0].position, Vec3::Zero());
+  for (int i = 0; i < 100; ++i) g.update(wps[0].position, Vec3::Zero(), kDt);
+  const Vec3 position(80, 2, -30), velocity(2.5, 0, 0);  // below the cruise
+  g.resync(position, velocity);
+  const GuidanceReference first = g.update(position, velocity, kDt);
+  EXPECT_LT((first.position - Vec3(80, 0, -30)).norm(), 1e-9);
+  EXPECT_NEAR(first.velocity.x(), 2.5, 1e-9);
+  const GuidanceReference second = g.update(position + velocity * kDt, velocity, kDt);
+  EXPECT_GT(second.position.x(), 80 + 2.5 * kDt);  // on, speeding up toward the cruise
+  EXPECT_LT(second.position.x(), 80 + 3.0 * kDt);
 }
 
 TEST(WaypointGuidance, RestartNearTheFirstLegStartsThere) {

@@ -41,6 +41,7 @@ void WaypointGuidance::resync(const Vec3& position, const Vec3& velocity) {
   s_ = std::clamp((position - leg_start_).dot(leg_dir_), 0.0, leg_length_);
   s_dot_ = std::clamp(velocity.dot(leg_dir_), 0.0, leg_speed_limit());
   s_ddot_ = 0;
+  just_synced_ = true;
 }
 
 double WaypointGuidance::leg_speed_limit() const {
@@ -54,6 +55,8 @@ double WaypointGuidance::leg_speed_limit() const {
 GuidanceReference WaypointGuidance::update(const Vec3& position, const Vec3& velocity, double dt) {
   GuidanceReference out;
   if (waypoints_.empty() || active_ < 0) return out;
+  if (just_synced_) dt = 0;
+  just_synced_ = false;
   const double accel = config_.accel_fraction * limits_.max_accel;
 
   // Leg switching: inside the capture radius of an intermediate waypoint,

@@ -45,7 +45,10 @@ class WaypointGuidance {
   /// after another source of reference (avoidance) has been flown.
   void resync(const Vec3& position, const Vec3& velocity);
 
-  /// Advances the reference by dt and returns it.
+  /// Advances the reference by dt and returns it. The first update after
+  /// set_mission or resync is taken to be at the instant they were given the
+  /// vehicle's state, so it does not advance: the reference starts on the
+  /// vehicle, not one step ahead of it.
   GuidanceReference update(const Vec3& position, const Vec3& velocity, double dt);
 
  private:
@@ -62,6 +65,7 @@ class WaypointGuidance {
   Vec3 leg_dir_ = Vec3::UnitX();
   double leg_length_ = 0;
   double s_ = 0, s_dot_ = 0, s_ddot_ = 0;
+  bool just_synced_ = false;
   bool done_ = false;
 };
 
