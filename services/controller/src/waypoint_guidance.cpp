@@ -9,8 +9,8 @@ void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, doubl
                                    const Limits& limits, const Vec3& position,
                                    const Vec3& velocity) {
   waypoints_ = waypoints;
-  // The cruise may not use the whole speed limit: the controller tracks to
-  // a few per cent (the yaw sweep shakes the speed), and the limit is hard.
+  // The cruise may not use the whole speed limit: the flown speed strays a
+  // few tenths of a per cent from the reference, and the limit is hard.
   cruise_speed_ = limits.max_speed > 0
                       ? std::min(cruise_speed, config_.speed_fraction * limits.max_speed)
                       : cruise_speed;

@@ -66,7 +66,7 @@ struct RhOptimizerServiceConfig {
   RhSettings optimizer = [] {
     RhSettings s;
     s.weights = Vec3(30.0, 30.0, 30.0);
-    s.speed_margin = 0.01;
+    s.speed_margin = 0.005;
     s.accel_margin = 0.06;
     s.clearance_margin = 0.5;
     return s;
