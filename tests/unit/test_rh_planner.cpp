@@ -163,6 +163,41 @@ TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {
   EXPECT_EQ(no_retry.step(impossible).solves, 1);
 }
 
+TEST(RhPlanner, KeepsAStopAtTheWaypointToItsEndButNotAPlanStillMoving) {
+  const ClearanceQuery open = field_with({});
+  // A step whose solve cannot succeed (terminal x out of reach), `left`
+  // seconds before the end of the plan `first` started at time 0.
+  auto failing_step_before_end = [&](const StepOutput& first, double left) {
+    const double t = first.trajectory.duration() - left;
+    StepInput later = input_at(first.trajectory.position(t), t, open);
+    later.problem.velocity = first.trajectory.velocity(t);
+    later.problem.terminal_x = 1000.0;
+    return later;
+  };
+
+  // Still at cruise speed where it ends: with 1 s left there is no time for
+  // the braking after it, so brake now.
+  RhPlanner passing;
+  const StepOutput moving = passing.step(input_at(Vec3(0, 0, -kAltitude), 0.0, open));
+  ASSERT_EQ(moving.mode, StepMode::kSolved) << moving.reason;
+  ASSERT_GT(moving.trajectory.velocity(moving.trajectory.duration()).norm(), 1.0);
+  EXPECT_EQ(passing.step(failing_step_before_end(moving, 1.0)).mode, StepMode::kBraking);
+
+  // Ending at rest on the last waypoint: it is kept to its end, and stops
+  // there rather than wherever braking would.
+  RhPlanner stopping;
+  StepInput last_leg = input_at(Vec3(260, 0, -kAltitude), 0.0, open);
+  last_leg.problem.terminal_x = 300.0;
+  last_leg.problem.stop_at_target = true;
+  const StepOutput stop = stopping.step(last_leg);
+  ASSERT_EQ(stop.mode, StepMode::kSolved) << stop.reason;
+  const StepOutput kept = stopping.step(failing_step_before_end(stop, 1.0));
+  EXPECT_EQ(kept.mode, StepMode::kKeptPrevious) << kept.reason;
+  EXPECT_EQ(kept.trajectory.control_points(), stop.trajectory.control_points());
+  // Once it has ended, it is no longer kept.
+  EXPECT_EQ(stopping.step(failing_step_before_end(stop, -0.5)).mode, StepMode::kBraking);
+}
+
 TEST(RhPlanner, KeepsThePreviousWhenTheIterationLimitStopsTheSolve) {
   RhSettings one_evaluation;
   one_evaluation.max_iterations = 1;

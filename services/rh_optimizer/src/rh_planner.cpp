@@ -7,9 +7,10 @@
 namespace ofn::rh {
 namespace {
 
-constexpr double kMinHold = 2.0;        // s a braking trajectory holds the hover
-constexpr double kKeepCheckStep = 0.1;  // s between clearance samples of a kept trajectory
-constexpr double kStoppedSpeed = 1e-3;  // m/s below which the vehicle counts as hovering
+constexpr double kMinHold = 2.0;           // s a braking trajectory holds the hover
+constexpr double kKeepCheckStep = 0.1;     // s between clearance samples of a kept trajectory
+constexpr double kStoppedSpeed = 1e-3;     // m/s below which the vehicle counts as hovering
+constexpr double kEndsAtRestSpeed = 0.05;  // m/s: a plan ending slower stops in a hover
 
 bool trajectory_finite(const BsplineTrajectory& trajectory) {
   if (trajectory.empty() || !std::isfinite(trajectory.duration())) return false;
@@ -139,7 +140,12 @@ StepOutput RhPlanner::step(const StepInput& input) {
   if (!has_previous()) return brake(failure + "; no previous trajectory");
   const double elapsed = input.time - previous_start_;
   const double remaining = previous_.duration() - elapsed;
-  if (remaining < fallback_.keep_min_remaining) {
+  // A kept trajectory must leave time for more solves and for the braking
+  // that would follow it, unless it ends at rest (a stop at the last
+  // waypoint, whose solves are the hardest): kept to its end, it is itself
+  // the braking, and it stops where it should.
+  const bool ends_at_rest = previous_.velocity(previous_.duration()).norm() < kEndsAtRestSpeed;
+  if (remaining <= 0.0 || (remaining < fallback_.keep_min_remaining && !ends_at_rest)) {
     std::ostringstream why;
     why << failure << "; previous has " << std::max(remaining, 0.0) << " s left, needs "
         << fallback_.keep_min_remaining;
