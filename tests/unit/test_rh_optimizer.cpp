@@ -266,6 +266,31 @@ TEST(RhOptimizer, OpenSpaceFromAStraightGuess) {
   }
 }
 
+TEST(RhOptimizer, AStartAboveTheAccelerationReserveIsBroughtInsideIt) {
+  // The start acceleration comes from the last plan, which is bounded only
+  // from its first collocation point on. Taken as it is, a start above the
+  // reserve let each plan climb a little higher than the one before.
+  const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
+  RhSettings settings;
+  settings.accel_margin = 0.06;
+  RhOptimizer optimizer(settings);
+  RhProblem problem = open_course_problem(open);
+  problem.position = problem.frame.to_world(Vec3(40.0, 2.0, 0.0));
+  problem.velocity = problem.frame.world_from_guidance.col(0) * open.cruise_speed;
+  problem.acceleration = problem.frame.world_from_guidance.col(1) * open.limits.max_accel;
+  problem.terminal_x = 40.0 + open.limits.sensor_range;
+  const SolveReport report = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
+  ASSERT_TRUE(report.feasible) << report.message;
+  const double reserve = (1.0 - settings.accel_margin) * open.limits.max_accel;
+  const Vec3 start = report.trajectory.acceleration(0.0);
+  EXPECT_NEAR(start.norm(), reserve, 1e-9);
+  EXPECT_NEAR(start.normalized().dot(problem.acceleration.normalized()), 1.0, 1e-9);
+  // Up to the first collocation point too, where nothing else holds it.
+  const double first_point = report.trajectory.duration() / settings.collocation_points;
+  for (int i = 0; i <= 20; ++i)
+    EXPECT_LE(report.trajectory.acceleration(first_point * i / 20).norm(), 1.005 * reserve);
+}
+
 TEST(RhOptimizer, StopsAtRestOnTheLastWaypoint) {
   // The last waypoint 40 m ahead, the vehicle 3 m beside the leg at cruise
   // speed: the trajectory ends on the waypoint at rest, within the limits.

@@ -166,7 +166,16 @@ void RhNlp::set_problem(const RhProblem& problem) {
   start_world_ = problem.position;
   const Mat3 guidance_from_world = world_from_guidance_.transpose();
   start_velocity_ = guidance_from_world * problem.velocity;
+  // The start acceleration is the last plan's at this instant. Nothing
+  // bounds a plan between its start and its first collocation point, so it
+  // can rise above the reserve there, and the next plan, starting from that,
+  // higher still: on random field 257 the reference rode at 102 % of the
+  // limit for a second. Held inside the reserve (a step in the reference of
+  // at most the reserve), the start breaks that chain.
+  const double accel_reserve = (1.0 - settings_.accel_margin) * problem.limits.max_accel;
   start_acceleration_ = guidance_from_world * problem.acceleration;
+  if (start_acceleration_.norm() > accel_reserve)
+    start_acceleration_ *= accel_reserve / start_acceleration_.norm();
   target_ = guidance_from_world * (problem.target - problem.position);
   terminal_x_ = problem.terminal_x - problem.frame.to_guidance(problem.position).x();
   stop_at_target_ = problem.stop_at_target;
@@ -181,8 +190,7 @@ void RhNlp::set_problem(const RhProblem& problem) {
       with_reserve(problem.limits.max_speed, settings_.speed_margin, problem.velocity.norm());
   max_vertical_speed_ =
       with_reserve(problem.limits.max_vertical_speed, settings_.speed_margin, problem.velocity.z());
-  max_accel_ =
-      with_reserve(problem.limits.max_accel, settings_.accel_margin, problem.acceleration.norm());
+  max_accel_ = accel_reserve;
   has_clearance_ = static_cast<bool>(problem.clearance);
   start_clearance_ = has_clearance_ ? problem.clearance(problem.position).distance
                                     : std::numeric_limits<double>::infinity();
