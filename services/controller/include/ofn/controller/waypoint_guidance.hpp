@@ -13,12 +13,12 @@
 namespace ofn::control {
 
 struct GuidanceConfig {
-  double accel_fraction = 0.8;   // of limits.max_accel used by the reference
+  double accel_fraction = 0.8;    // of limits.max_accel used by the reference
   double speed_fraction = 0.995;  // of limits.max_speed the cruise may reach
-  double speed_gain = 1.0;       // 1/s, how briskly the reference speed follows its target
-  double jerk_fraction = 0.5;    // 1/s: jerk limit as a multiple of limits.max_accel per second
-  double max_lead = 8.0;         // m the reference may run ahead of the vehicle along track
-  double stop_speed = 0.3;       // m/s, at or below this at the last waypoint counts as arrived
+  double speed_gain = 1.0;        // 1/s, how briskly the reference speed follows its target
+  double jerk_fraction = 0.5;     // 1/s: jerk limit as a multiple of limits.max_accel per second
+  double max_lead = 8.0;          // m the reference may run ahead of the vehicle along track
+  double stop_speed = 0.3;        // m/s, at or below this at the last waypoint counts as arrived
 };
 
 struct GuidanceReference {
