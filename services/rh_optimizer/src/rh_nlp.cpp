@@ -180,9 +180,10 @@ void RhNlp::set_problem(const RhProblem& problem) {
   terminal_x_ = problem.terminal_x - problem.frame.to_guidance(problem.position).x();
   stop_at_target_ = problem.stop_at_target;
   // Bounds of the terminal speed rows and of the control points: a start
-  // already inside the reserve (up to the limit itself) sets them. The
-  // path constraints (PointConstraintModel) keep the plain reserve: relieved
-  // there too, bench5 commanded 103 % of the acceleration limit.
+  // speed already inside the reserve (up to the limit itself) sets them.
+  // The path constraints (PointConstraintModel) keep the plain reserve:
+  // relieved there too, bench5 commanded 103 % of the acceleration limit.
+  // The acceleration needs no such relief, its start being held inside.
   const auto with_reserve = [](double limit, double margin, double at_start) {
     return std::max((1.0 - margin) * limit, std::min(std::abs(at_start), limit));
   };
