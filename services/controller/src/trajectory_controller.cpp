@@ -11,11 +11,6 @@ bool finite(const vehicle::Controls& c) {
          std::isfinite(c.lat_cyclic) && std::isfinite(c.pedal);
 }
 
-Vec3 clamp_norm(const Vec3& v, double limit) {
-  const double n = v.norm();
-  return n > limit ? v * (limit / n) : v;
-}
-
 }  // namespace
 
 TrajectoryController::TrajectoryController(vehicle::RotorcraftParams nominal, ControllerGains gains,

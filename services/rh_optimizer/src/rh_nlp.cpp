@@ -173,9 +173,7 @@ void RhNlp::set_problem(const RhProblem& problem) {
   // limit for a second. Held inside the reserve (a step in the reference of
   // at most the reserve), the start breaks that chain.
   const double accel_reserve = (1.0 - settings_.accel_margin) * problem.limits.max_accel;
-  start_acceleration_ = guidance_from_world * problem.acceleration;
-  if (start_acceleration_.norm() > accel_reserve)
-    start_acceleration_ *= accel_reserve / start_acceleration_.norm();
+  start_acceleration_ = clamp_norm(guidance_from_world * problem.acceleration, accel_reserve);
   target_ = guidance_from_world * (problem.target - problem.position);
   terminal_x_ = problem.terminal_x - problem.frame.to_guidance(problem.position).x();
   stop_at_target_ = problem.stop_at_target;

@@ -55,6 +55,12 @@ inline Vec3 to_vec3(const double (&a)[3]) {
   return Vec3(a[0], a[1], a[2]);
 }
 
+/// v scaled down to length `limit` if it is longer; otherwise v.
+inline Vec3 clamp_norm(const Vec3& v, double limit) {
+  const double n = v.norm();
+  return n > limit ? Vec3(v * (limit / n)) : v;
+}
+
 /// Distance from p to the segment a-b (to a when the segment is a point).
 inline double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
   const Vec3 ab = b - a;
