@@ -225,10 +225,8 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   mission_ = m;
   legs_.clear();
   active_leg_ = -1;
-  planner_.reset();
+  restart_planning();
   switch_.reset();
-  stopping_at_target_ = false;
-  stalled_ = false;
   visibility_.clear();
   shadows_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
@@ -329,12 +327,16 @@ void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& 
   m.acceleration = {{0, 0, 0}, {0, 0, 0}};
   m.num_samples = 2;
   node_.publish(channels::kRefTraj, m);
-  planner_.reset();
+  restart_planning();
   last_trajectory_ = BsplineTrajectory();
-  stopping_at_target_ = false;
-  stalled_ = false;
   node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
                    why);
+}
+
+void RhOptimizerService::restart_planning() {
+  planner_.reset();
+  stopping_at_target_ = false;
+  stalled_ = false;
 }
 
 void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::string& message,
