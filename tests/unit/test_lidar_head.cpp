@@ -319,12 +319,10 @@ TEST(LidarHead, ScansStartOnWholePeriodsAndADisabledHeadIsSilent) {
 
 class LidarConfigFile : public ::testing::Test {
  protected:
+  // Parsed in memory: a shared file would be overwritten by the suite's other tests,
+  // which ctest runs in parallel processes.
   VehicleSimConfig load(const std::string& text) {
-    const std::string path = ::testing::TempDir() + "/lidar_sim.yaml";
-    FILE* f = std::fopen(path.c_str(), "w");
-    std::fputs(text.c_str(), f);
-    std::fclose(f);
-    auto reader = YamlReader::load_file(path);
+    YamlReader reader(YAML::Load(text), "lidar_sim.yaml", "");
     return load_vehicle_sim_config(reader);
   }
   void expect_error_names(const std::string& text, const std::string& field) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -171,7 +173,9 @@ TEST(VehicleVariation, ScalesTheAirframeAndSetsActuatorAuthority) {
 }
 
 std::string write_scenario(const std::string& name, const std::string& extra) {
-  const std::string path = ::testing::TempDir() + "/" + name + ".yaml";
+  // The process id keeps parallel test processes (and parallel builds) apart.
+  const std::string path =
+      ::testing::TempDir() + "/ofn_" + name + "_" + std::to_string(::getpid()) + ".yaml";
   std::ofstream(path) << "name: " << name
                       << "\nunits: ft\nstart:\n  position: [0, 0, 100]\nwaypoints:\n"
                          "  - position: [100, 0, 100]\nlimits:\n  max_speed: 10\n"
