@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <utility>
 
 #include "ofn/mapper/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
@@ -248,6 +249,31 @@ TEST(RhPlanner, BrakesWhenThePreviousRunsIntoANewObstacle) {
   EXPECT_NE(out.reason.find("previous"), std::string::npos) << out.reason;
   EXPECT_TRUE(finite(out.trajectory));
   EXPECT_DOUBLE_EQ(out.start_time, 0.2);
+}
+
+TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
+  // A wall across the whole map, higher than the field, 55 m ahead: no
+  // solution passes it, and the previous plan, made before it was seen,
+  // comes within R_s of it 16 s on.
+  auto fail_against_wall_at = [](double wall_north) {
+    RhPlanner planner;
+    const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+    EXPECT_EQ(first.mode, StepMode::kSolved) << first.reason;
+    const int north = static_cast<int>(wall_north);
+    StepInput input = input_at(first.trajectory.position(0.2), 0.2,
+                               field_with({{north, north + 3, -60, 60, 200.0f}}));
+    input.problem.velocity = first.trajectory.velocity(0.2);
+    return std::make_pair(planner.braking_window(input.problem), planner.step(input));
+  };
+  // 9.8 s: braking from 3.048 m/s at 0.8 of 0.4877 m/s^2, plus the 2 s kept.
+  const auto [window, far] = fail_against_wall_at(55.0);
+  EXPECT_NEAR(window, 3.048 / (0.8 * 0.4877) + 2.0, 1e-9);
+  EXPECT_EQ(far.mode, StepMode::kKeptPrevious) << far.reason;
+  EXPECT_DOUBLE_EQ(far.start_time, 0.0);
+  // The same wall 30 m ahead, met 7.6 s on, inside the window: brake now.
+  const auto near = fail_against_wall_at(30.0).second;
+  EXPECT_EQ(near.mode, StepMode::kBraking) << near.reason;
+  EXPECT_NE(near.reason.find("previous comes within"), std::string::npos) << near.reason;
 }
 
 TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {

@@ -56,8 +56,7 @@ BsplineTrajectory RhPlanner::braking_trajectory(const RhProblem& problem) const 
   // point, which lies at v t_stop / 2) and whose second is the hover.
   Vec3 position = problem.position.allFinite() ? problem.position : Vec3::Zero();
   Vec3 velocity = problem.velocity.allFinite() ? problem.velocity : Vec3::Zero();
-  const double limit = problem.limits.max_accel * fallback_.braking_accel_fraction;
-  const double decel = std::isfinite(limit) && limit > 1e-6 ? limit : 1.0;
+  const double decel = braking_decel(problem);
   const double speed = velocity.norm();
   const double stop_time = speed > kStoppedSpeed ? speed / decel : 0.0;
   if (stop_time == 0.0) velocity.setZero();
@@ -68,6 +67,19 @@ BsplineTrajectory RhPlanner::braking_trajectory(const RhProblem& problem) const 
   // constant trajectory.
   const double knot = stop_time > 0 ? stop_time / duration : 0.5;
   return BsplineTrajectory(2, {0, 0, 0, knot, 1, 1, 1}, {position, stop, stop, stop}, duration);
+}
+
+double RhPlanner::braking_decel(const RhProblem& problem) const {
+  const double limit = problem.limits.max_accel * fallback_.braking_accel_fraction;
+  return std::isfinite(limit) && limit > 1e-6 ? limit : 1.0;
+}
+
+double RhPlanner::braking_window(const RhProblem& problem) const {
+  // The speed the kept plan may reach: at least the speed limit, whatever
+  // the vehicle flies now.
+  const double speed = std::max(problem.velocity.norm(), problem.limits.max_speed);
+  const double stop_time = std::isfinite(speed) ? speed / braking_decel(problem) : 0.0;
+  return stop_time + fallback_.keep_min_remaining;
 }
 
 StepOutput RhPlanner::step(const StepInput& input) {
@@ -152,9 +164,15 @@ StepOutput RhPlanner::step(const StepInput& input) {
     return brake(why.str());
   }
   if (problem.clearance) {
-    const int samples = std::max(2, static_cast<int>(std::ceil(remaining / kKeepCheckStep)));
+    // Only the part of the kept plan that braking could no longer avoid has
+    // to be clear: a conflict farther ahead is met by the next steps, which
+    // check it again, solve again, and brake before it comes this close. A
+    // new cuboid grazing the far end of the horizon then costs a replan, not
+    // a stop at cruise speed.
+    const double checked = std::min(remaining, braking_window(problem));
+    const int samples = std::max(2, static_cast<int>(std::ceil(checked / kKeepCheckStep)));
     for (int k = 0; k <= samples; ++k) {
-      const double t = elapsed + remaining * k / samples;
+      const double t = elapsed + checked * k / samples;
       const double clearance = problem.clearance(previous_.position(t)).distance;
       if (!(clearance >= problem.limits.clearance)) {
         std::ostringstream why;

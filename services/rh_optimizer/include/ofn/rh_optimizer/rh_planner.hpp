@@ -70,10 +70,16 @@ class RhPlanner {
   /// The braking trajectory: from the state now to a hover along the
   /// current velocity at braking_accel_fraction of the limit.
   BsplineTrajectory braking_trajectory(const RhProblem& problem) const;
+  /// How far ahead (s) a kept trajectory must be clear of obstacles: the
+  /// time to brake from the larger of the current speed and the speed limit,
+  /// plus keep_min_remaining.
+  double braking_window(const RhProblem& problem) const;
 
   const RhOptimizer& optimizer() const { return optimizer_; }
 
  private:
+  double braking_decel(const RhProblem& problem) const;
+
   RhOptimizer optimizer_;
   FallbackSettings fallback_;
   BsplineTrajectory previous_;  // last feasible solution
