@@ -118,6 +118,22 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   b.stall_retry = f.boolean("stall_retry", b.stall_retry);
   f.finish();
 
+  // The stop's deceleration is fallback.braking_accel_fraction and its
+  // ground rule the optimiser's: RhPlanner passes them to the gate.
+  YamlReader g = r.child("commit");
+  CommitSettings& k = c.commit;
+  k.commit_time = g.number_in("commit_time", k.commit_time, 0.0, 10.0);
+  k.stop_clearance_fraction =
+      g.number_in("stop_clearance_fraction", k.stop_clearance_fraction, 0.0, 2.0);
+  k.unseen_clearance_fraction =
+      g.number_in("unseen_clearance_fraction", k.unseen_clearance_fraction, 0.0, 2.0);
+  k.position_tolerance = g.number_in("position_tolerance", k.position_tolerance, 1e-4, 10.0);
+  k.velocity_tolerance = g.number_in("velocity_tolerance", k.velocity_tolerance, 1e-4, 10.0);
+  k.acceleration_tolerance =
+      g.number_in("acceleration_tolerance", k.acceleration_tolerance, 1e-4, 10.0);
+  k.limit_tolerance = g.number_in("limit_tolerance", k.limit_tolerance, 0.0, 0.5);
+  g.finish();
+
   YamlReader a = r.child("avoidance");
   SwitchSettings& w = c.avoidance;
   w.engage_margin = a.number_in("engage_margin", w.engage_margin, 0.0, 100.0);
@@ -190,7 +206,7 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
                                        RhOptimizerServiceConfig config)
     : node_("rh_optimizer", lcm, clock),
       config_(std::move(config)),
-      planner_(config_.optimizer, config_.fallback),
+      planner_(config_.optimizer, config_.fallback, config_.commit),
       switch_(config_.avoidance),
       visibility_(1.0, config_.visibility_band),
       field_(config_.field) {
@@ -309,6 +325,14 @@ bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
 
 void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& velocity,
                                    const std::string& why) {
+  publish_nominal(now, position, velocity);
+  restart_planning();
+  last_trajectory_ = BsplineTrajectory();
+  node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
+                   why);
+}
+
+void RhOptimizerService::publish_nominal(Utime now, const Vec3& position, const Vec3& velocity) {
   // Two samples of where the vehicle is: a NOMINAL trajectory tells the
   // controller to drop the avoidance reference now.
   ref_traj_t m;
@@ -327,10 +351,6 @@ void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& 
   m.acceleration = {{0, 0, 0}, {0, 0, 0}};
   m.num_samples = 2;
   node_.publish(channels::kRefTraj, m);
-  restart_planning();
-  last_trajectory_ = BsplineTrajectory();
-  node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
-                   why);
 }
 
 void RhOptimizerService::restart_planning() {
@@ -398,7 +418,15 @@ void RhOptimizerService::tick() {
   const bool engaged =
       switch_.update(t, conflict, cross_track_distance(leg, position), stopping_speed);
   if (!engaged) {
-    if (was_engaged) hand_back(now, position, velocity, "nominal path clear, back on the leg");
+    if (was_engaged) {
+      hand_back(now, position, velocity, "nominal path clear, back on the leg");
+    } else if (++ticks_since_nominal_ >= static_cast<int64_t>(std::ceil(config_.rate))) {
+      // Once a second while guidance is clear: a controller left flying the
+      // stop of a plan from an optimiser that has since died and restarted
+      // learns that guidance may resume.
+      publish_nominal(now, position, velocity);
+      ticks_since_nominal_ = 0;
+    }
     note("nominal guidance");
     return publish_stats(now, solver_stats_t::NOT_RUN, "nominal guidance: path clear", nullptr);
   }
@@ -462,6 +490,8 @@ void RhOptimizerService::tick() {
     in.global_path = route_;
   in.global_path_changed = route_changed_;
   route_changed_ = false;
+  if (config_.occlusion_depth > 0)
+    in.seen = [this](double north, double east) { return visibility_.seen(north, east); };
 
   const bool had_trajectory = planner_.has_previous();
   const StepOutput out = planner_.step(in);

@@ -42,8 +42,31 @@ const char* to_string(StepMode mode) {
   return "unknown";
 }
 
-RhPlanner::RhPlanner(RhSettings settings, FallbackSettings fallback)
-    : optimizer_(settings), fallback_(fallback) {}
+namespace {
+
+// The gate brakes as the fallback does and keeps the optimiser's ground
+// rule: one setting each, here.
+CommitSettings with_planner_rules(CommitSettings commit, const RhSettings& settings,
+                                  const FallbackSettings& fallback) {
+  commit.braking_accel_fraction = fallback.braking_accel_fraction;
+  commit.min_altitude = settings.min_altitude;
+  commit.ground_altitude = settings.ground_altitude;
+  return commit;
+}
+
+}  // namespace
+
+RhPlanner::RhPlanner(RhSettings settings, FallbackSettings fallback, CommitSettings commit)
+    : optimizer_(settings),
+      fallback_(fallback),
+      gate_(with_planner_rules(commit, settings, fallback)) {}
+
+CommitCheck RhPlanner::gate_check(const BsplineTrajectory& plan, double elapsed,
+                                  const StepInput& input) const {
+  const RhProblem& p = input.problem;
+  return gate_.check(plan, elapsed, FlownState{p.position, p.velocity, p.acceleration}, p.limits,
+                     SafetyMap{p.clearance, input.seen});
+}
 
 void RhPlanner::reset() {
   previous_ = BsplineTrajectory();
@@ -88,10 +111,13 @@ StepOutput RhPlanner::step(const StepInput& input) {
   StepOutput out;
   const RhProblem& problem = input.problem;
   auto brake = [&](const std::string& why) {
+    // The stop from the state flown now; the plan it leaves is forgotten,
+    // so no later fallback returns to where the vehicle no longer is.
     out.mode = StepMode::kBraking;
     out.trajectory = braking_trajectory(problem);
     out.start_time = std::isfinite(input.time) ? input.time : 0.0;
     out.reason = why;
+    reset();
     return out;
   };
 
@@ -117,6 +143,13 @@ StepOutput RhPlanner::step(const StepInput& input) {
                ? RhOptimizer::guess_straight(problem)
                : RhOptimizer::guess_from_path(input.global_path, problem, cruise);
   };
+  // A feasible, finite plan that the commit gate accepts.
+  auto committable = [&](const SolveReport& report) {
+    if (!report.feasible || !trajectory_finite(report.trajectory)) return false;
+    out.commit = gate_check(report.trajectory, 0.0, input);
+    if (!out.commit.committed) ++out.refused;
+    return out.commit.committed;
+  };
 
   const bool warm = has_previous() && !input.global_path_changed;
   InitialGuess guess =
@@ -125,23 +158,29 @@ StepOutput RhPlanner::step(const StepInput& input) {
   if (guess.positions.empty()) guess = cold_guess();
   out.report = optimizer_.solve(problem, guess);
   out.solves = 1;
-  if (!out.report.feasible && guess.warm && fallback_.cold_retry) {
+  bool accepted = committable(out.report);
+  if (!accepted && guess.warm && fallback_.cold_retry) {
+    // A warm solve that failed, or whose plan has no safe stop: once more
+    // from the route.
     out.report = optimizer_.solve(problem, cold_guess());
     out.solves = 2;
-  } else if (out.report.feasible && guess.warm && fallback_.stall_retry &&
+    accepted = committable(out.report);
+  } else if (accepted && guess.warm && fallback_.stall_retry &&
              plan_stalled(out.report.trajectory, problem)) {
     SolveReport cold = optimizer_.solve(problem, cold_guess());
     out.solves = 2;
     out.stalled = true;
-    if (cold.feasible && cold.cost < out.report.cost) {
+    const CommitCheck warm_check = out.commit;
+    if (cold.cost < out.report.cost && committable(cold)) {
       out.report = std::move(cold);
       out.reason = "warm plan stalled; the plan from the route is cheaper";
     } else {
+      out.commit = warm_check;
       out.reason = "warm plan stalled; the plan from the route is no better";
     }
   }
 
-  if (out.report.feasible && trajectory_finite(out.report.trajectory)) {
+  if (accepted) {
     out.mode = StepMode::kSolved;
     out.trajectory = out.report.trajectory;
     out.start_time = input.time;
@@ -150,7 +189,8 @@ StepOutput RhPlanner::step(const StepInput& input) {
     return out;
   }
 
-  const std::string failure = "solve failed (" + out.report.message + ")";
+  std::string failure = "solve failed (" + out.report.message + ")";
+  if (out.report.feasible && out.refused > 0) failure = "plan refused (" + out.commit.reason + ")";
   if (!has_previous()) return brake(failure + "; no previous trajectory");
   const double elapsed = input.time - previous_start_;
   const double remaining = previous_.duration() - elapsed;
@@ -184,6 +224,14 @@ StepOutput RhPlanner::step(const StepInput& input) {
       }
     }
   }
+  // The kept plan must still start on the state flown now and carry a safe
+  // stop on today's map, as a new one would.
+  const CommitCheck kept = gate_check(previous_, elapsed, input);
+  if (!kept.committed) {
+    out.commit = kept;
+    return brake(failure + "; previous refused (" + kept.reason + ")");
+  }
+  out.commit = kept;
   out.mode = StepMode::kKeptPrevious;
   out.trajectory = previous_;
   out.start_time = previous_start_;

@@ -72,6 +72,7 @@ struct RhOptimizerServiceConfig {
     return s;
   }();
   FallbackSettings fallback;
+  CommitSettings commit;  // the safety invariant of every published plan
   SwitchSettings avoidance;
 };
 
@@ -109,6 +110,7 @@ class RhOptimizerService {
   void tick();
   bool refresh_field(Utime now, const Vec3& vehicle);
   void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
+  void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
   /// Forgets the planner's previous plan and the engagement's stop and
   /// stall flags (a new mission, a hand-back).
   void restart_planning();
@@ -141,6 +143,7 @@ class RhOptimizerService {
   bool stopping_at_target_ = false;  // the last plan stops at the last waypoint
   bool stalled_ = false;             // the last step's warm plan was a stall (logged once)
   int64_t steps_ = 0;
+  int64_t ticks_since_nominal_ = 0;
   std::string last_note_;
 };
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ofn/rh_optimizer/commit_gate.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 
 namespace ofn::rh {
@@ -42,10 +43,13 @@ enum class StepMode { kSolved, kKeptPrevious, kBraking };
 const char* to_string(StepMode mode);
 
 struct StepInput {
+  /// The problem's start (position, velocity, acceleration) is the state the
+  /// controller flies now: every committed plan starts on it (CommitGate).
   RhProblem problem;
   double time = 0;                   // s, clock time of the problem's state
   std::vector<Vec3> global_path;     // world NED; empty when there is none
   bool global_path_changed = false;  // a new route since the last step
+  SeenQuery seen;                    // cells seen free; empty: the stops skip that rule
 };
 
 struct StepOutput {
@@ -56,11 +60,14 @@ struct StepOutput {
   int solves = 0;                // solves run this step (a cold or stall retry makes 2)
   std::string reason;            // why a fallback was taken, or what the stall retry did
   bool stalled = false;          // the warm plan was a stall (plan_stalled) and was retried
+  CommitCheck commit;            // the commit gate's check of the plan flown (or the last refused)
+  int refused = 0;               // feasible plans the commit gate refused this step
 };
 
 class RhPlanner {
  public:
-  explicit RhPlanner(RhSettings settings = {}, FallbackSettings fallback = {});
+  explicit RhPlanner(RhSettings settings = {}, FallbackSettings fallback = {},
+                     CommitSettings commit = {});
 
   StepOutput step(const StepInput& input);
   /// Forgets the previous solution (after avoidance hands back).
@@ -76,13 +83,19 @@ class RhPlanner {
   double braking_window(const RhProblem& problem) const;
 
   const RhOptimizer& optimizer() const { return optimizer_; }
+  const CommitGate& gate() const { return gate_; }
 
  private:
   double braking_decel(const RhProblem& problem) const;
+  CommitCheck gate_check(const BsplineTrajectory& plan, double elapsed,
+                         const StepInput& input) const;
 
   RhOptimizer optimizer_;
   FallbackSettings fallback_;
-  BsplineTrajectory previous_;  // last feasible solution
+  CommitGate gate_;
+  // The committed solution the controller flies; empty once a stop is
+  // flown, so a fallback never returns to a plan the vehicle has left.
+  BsplineTrajectory previous_;
   double previous_start_ = 0;
 };
 
