@@ -30,6 +30,18 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.status_rate = r.number_in("status_rate_hz", c.status_rate, 1.0, 1000.0);
   c.nav_timeout = r.number_in("nav_timeout", c.nav_timeout, 0.01, 10.0);
   c.ref_traj_timeout = r.number_in("ref_traj_timeout", c.ref_traj_timeout, 0.01, 10.0);
+  YamlReader selector = r.child("reference_selector");
+  c.selector.jump_position =
+      selector.number_in("jump_position", c.selector.jump_position, 0.01, 100.0);
+  c.selector.jump_velocity =
+      selector.number_in("jump_velocity", c.selector.jump_velocity, 0.01, 100.0);
+  c.selector.resync_position =
+      selector.number_in("resync_position", c.selector.resync_position, 0.01, 100.0);
+  c.selector.resync_velocity =
+      selector.number_in("resync_velocity", c.selector.resync_velocity, 0.01, 100.0);
+  c.selector.stop_accel_fraction =
+      selector.number_in("stop_accel_fraction", c.selector.stop_accel_fraction, 0.05, 1.0);
+  selector.finish();
   YamlReader outer = r.child("outer_loop");
   c.gains.position = read_vec3(outer, "position_gain", c.gains.position);
   c.gains.velocity = read_vec3(outer, "velocity_gain", c.gains.velocity);
@@ -129,6 +141,7 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
       config_(std::move(config)),
       controller_(config_.nominal, config_.gains, make_adaptive_element(config_.adaptive)),
       guidance_(config_.guidance),
+      selector_(config_.selector),
       path_heading_(config_.heading) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
@@ -155,8 +168,46 @@ void ControllerService::on_mission(const mission_t& m) {
   if (mission_ && same_plan(*mission_, m)) return;
   mission_ = m;
   mission_pending_ = true;
+  // A new plan starts under guidance; the optimiser restarts with it.
+  ref_traj_.reset();
+  selector_.hand_back();
   node_.log().info("mission {} '{}': {} waypoints, cruise {:.2f} m/s", m.mission_id, m.name,
                    m.num_waypoints, m.cruise_speed);
+}
+
+void ControllerService::on_ref_traj(const ref_traj_t& m) {
+  if (m.mode == ref_traj_t::NOMINAL) {
+    ref_traj_.reset();
+    selector_.hand_back();
+    return;
+  }
+  // Its state now (or at its start, if that is a few ms ahead of this
+  // clock) against the reference flown now and the vehicle.
+  const Utime now = node_.now();
+  const auto offered = sample_ref_traj(m, std::max(now, m.t0_utime));
+  if (!offered) {
+    node_.reject(channels::kRefTraj, "plan does not cover the present");
+    return;
+  }
+  std::optional<Reference> flown;
+  const bool flying = last_step_ != INT64_MIN &&
+                      (mode_ == control_status_t::TRAJECTORY ||
+                       mode_ == control_status_t::WAYPOINT || mode_ == control_status_t::SAFE_STOP);
+  if (flying) {
+    // The reference of the last step, carried on to now.
+    Reference r = last_ref_;
+    r.position += r.velocity * std::max(0.0, to_seconds(now - last_step_));
+    flown = r;
+  }
+  const Vec3 position = nav_ ? to_vec3(nav_->position) : offered->position;
+  const Vec3 velocity = nav_ ? to_vec3(nav_->velocity) : offered->velocity;
+  if (const auto why = selector_.check_start(*offered, flown, position, velocity)) {
+    node_.reject(channels::kRefTraj, "plan starts off the reference flown and the vehicle");
+    node_.log().warn("REF_TRAJ refused: {}", *why);
+    return;
+  }
+  ref_traj_ = m;
+  selector_.plan_flown();
 }
 
 void ControllerService::on_lidar_scan() {
@@ -241,8 +292,16 @@ void ControllerService::control_step() {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;
     facing = facing_along(ref.velocity, config_.heading.min_speed);
+  } else if (selector_.avoiding()) {
+    // The plan went stale mid-avoidance: its stop, then the hover.
+    if (!selector_.stopping())
+      node_.log().warn("avoidance plan stale at t={:.2f} s: flying its stop", to_seconds(now));
+    mode_ = control_status_t::SAFE_STOP;
+    ref = selector_.safe_stop(to_seconds(now), last_ref_, mission_->limits.max_accel);
+    facing = facing_along(ref.velocity, config_.heading.min_speed);
   } else {
-    if (previous == control_status_t::TRAJECTORY) guidance_.resync(x.position, x.velocity);
+    if (previous == control_status_t::TRAJECTORY || previous == control_status_t::SAFE_STOP)
+      guidance_.resync(x.position, x.velocity);
     const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
     active_waypoint_ = g.active_waypoint;
     ref.position = g.position;

@@ -10,6 +10,7 @@
 #include "ofn/common/node.hpp"
 #include "ofn/controller/heading_reference.hpp"
 #include "ofn/controller/neural_adaptation.hpp"
+#include "ofn/controller/reference_selector.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
 #include "ofn/lidar_scan_t.hpp"
@@ -24,6 +25,7 @@ struct ControllerConfig {
   double status_rate = 50.0;      // Hz, CONTROL_STATUS
   double nav_timeout = 0.2;       // s; older navigation counts as lost
   double ref_traj_timeout = 0.5;  // s; an older REF_TRAJ is no longer followed
+  SelectorSettings selector;      // plan jumps refused; the stop when plans go stale
   ControllerGains gains;
   AdaptiveConfig adaptive;
   GuidanceConfig guidance;
@@ -48,14 +50,10 @@ class ControllerService {
  private:
   void on_nav(const nav_state_t& m) { nav_ = m; }
   void on_mission(const mission_t& m);
-  // A NOMINAL trajectory is advice only: waypoint guidance keeps flying.
-  // Avoidance, a kept previous plan and braking override it (paper 2.1).
-  void on_ref_traj(const ref_traj_t& m) {
-    if (m.mode == ref_traj_t::NOMINAL)
-      ref_traj_.reset();
-    else
-      ref_traj_ = m;
-  }
+  // A NOMINAL trajectory hands back to waypoint guidance. Avoidance, a kept
+  // previous plan and braking override it (paper 2.1), if they start on the
+  // reference flown now or on the vehicle.
+  void on_ref_traj(const ref_traj_t& m);
   void on_lidar_scan();
   void control_step();
   void publish_status();
@@ -65,6 +63,7 @@ class ControllerService {
   ControllerConfig config_;
   TrajectoryController controller_;
   WaypointGuidance guidance_;
+  ReferenceSelector selector_;
   std::optional<nav_state_t> nav_;
   std::optional<mission_t> mission_;
   bool mission_pending_ = false;

@@ -1,0 +1,68 @@
+#pragma once
+// What the controller flies when the RH optimiser's plans change or stop:
+//  - a new avoidance reference is taken only if it starts on the reference
+//    flown now, or on the vehicle (the optimiser restarts a plan at the
+//    measured state when the vehicle is far off its plan); any other start
+//    is a jump, refused with a reason, and the reference flown is kept;
+//  - once avoidance has overridden guidance, a reference that goes stale
+//    (a dead, stopped or cut-off optimiser) is not followed by waypoint
+//    guidance, which would fly the blocked leg: the controller flies the
+//    stop of braking.hpp from the reference it was flying, the same stop
+//    the optimiser checked before it committed that plan, and then hovers,
+//    until a fresh plan or the optimiser's hand-back (NOMINAL) arrives.
+// Pure core, SI, world NED; time in seconds of the caller's clock.
+
+#include <optional>
+#include <string>
+
+#include "ofn/common/braking.hpp"
+#include "ofn/controller/trajectory_controller.hpp"
+
+namespace ofn::control {
+
+struct SelectorSettings {
+  double jump_position = 0.5;  // m a new plan may start off the reference flown now
+  double jump_velocity = 0.5;  // m/s
+  /// A plan restarted at the vehicle: within this of the measured state.
+  double resync_position = 1.5;      // m
+  double resync_velocity = 1.0;      // m/s
+  double stop_accel_fraction = 0.8;  // of the acceleration limit (the optimiser's braking)
+};
+
+class ReferenceSelector {
+ public:
+  explicit ReferenceSelector(SelectorSettings settings = {}) : settings_(settings) {}
+
+  /// A new avoidance plan whose state now is `offered`, while the reference
+  /// flown now is `flown` (nullopt before any) and the vehicle is at
+  /// (position, velocity). Returns the reason it is refused, or nullopt.
+  std::optional<std::string> check_start(const Reference& offered,
+                                         const std::optional<Reference>& flown,
+                                         const Vec3& position, const Vec3& velocity) const;
+
+  /// An avoidance plan is being flown (set on every accepted plan).
+  void plan_flown() {
+    avoiding_ = true;
+    stop_.reset();
+  }
+  /// The optimiser handed back (NOMINAL) or a new mission began.
+  void hand_back() {
+    avoiding_ = false;
+    stop_.reset();
+  }
+  bool avoiding() const { return avoiding_; }
+  bool stopping() const { return stop_.has_value(); }
+
+  /// The reference while the plan is stale: the stop from `flown` (the
+  /// reference of the last step) begun at the first call, at `max_accel`
+  /// times stop_accel_fraction, then the hover at its end.
+  Reference safe_stop(double now, const Reference& flown, double max_accel);
+
+ private:
+  SelectorSettings settings_;
+  bool avoiding_ = false;
+  std::optional<StopProfile> stop_;
+  double stop_start_ = 0;
+};
+
+}  // namespace ofn::control

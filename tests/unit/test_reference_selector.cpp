@@ -1,0 +1,77 @@
+// The controller's reference selection: plan jumps refused, and the stop
+// (not waypoint guidance) when an avoidance plan goes stale.
+
+#include <gtest/gtest.h>
+
+#include "ofn/controller/reference_selector.hpp"
+
+namespace ofn::control {
+namespace {
+
+Reference at(const Vec3& position, const Vec3& velocity) {
+  Reference r;
+  r.position = position;
+  r.velocity = velocity;
+  return r;
+}
+
+TEST(ReferenceSelector, RefusesAPlanThatStartsOffTheReferenceAndTheVehicle) {
+  const ReferenceSelector selector;
+  const Reference flown = at(Vec3(24, 0, -30), Vec3(0, 0, 0));
+  // The 16 m jump of a stale plan resurrected after braking.
+  const auto refused = selector.check_start(at(Vec3(40, 0, -30), Vec3(3, 0, 0)), flown,
+                                            Vec3(24.1, 0, -30), Vec3::Zero());
+  ASSERT_TRUE(refused.has_value());
+  EXPECT_NE(refused->find("off the reference flown"), std::string::npos) << *refused;
+  // On the reference flown: accepted.
+  EXPECT_FALSE(selector
+                   .check_start(at(Vec3(24.2, 0, -30), Vec3(0.1, 0, 0)), flown, Vec3(24.1, 0, -30),
+                                Vec3::Zero())
+                   .has_value());
+  // Off the reference but on the vehicle (a plan restarted at the measured
+  // state): accepted.
+  EXPECT_FALSE(selector
+                   .check_start(at(Vec3(28.0, 0, -30), Vec3(0.5, 0, 0)), flown, Vec3(28.3, 0, -30),
+                                Vec3(0.4, 0, 0))
+                   .has_value());
+  // Before any reference is flown, only a start on the vehicle is taken.
+  EXPECT_TRUE(selector
+                  .check_start(at(Vec3(40, 0, -30), Vec3::Zero()), std::nullopt, Vec3(24, 0, -30),
+                               Vec3::Zero())
+                  .has_value());
+  Reference bad = at(Vec3(24, 0, -30), Vec3::Zero());
+  bad.acceleration.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(selector.check_start(bad, flown, Vec3(24, 0, -30), Vec3::Zero()).has_value());
+}
+
+TEST(ReferenceSelector, AStalePlanIsFollowedByItsStopAndAHover) {
+  ReferenceSelector selector;
+  EXPECT_FALSE(selector.avoiding());
+  selector.plan_flown();
+  ASSERT_TRUE(selector.avoiding());
+  const double max_accel = 0.4877;
+  const Reference flown = at(Vec3(10, 0, -30), Vec3(3.0, 0, 0));
+  const Reference first = selector.safe_stop(100.0, flown, max_accel);
+  EXPECT_TRUE(selector.stopping());
+  EXPECT_LT((first.position - flown.position).norm(), 1e-12);  // continuous
+  EXPECT_LT((first.velocity - flown.velocity).norm(), 1e-12);
+  EXPECT_NEAR(first.acceleration.x(), -0.8 * max_accel, 1e-12);
+  // The stop is fixed at its start: later calls ignore the reference passed.
+  const double stop_time = 3.0 / (0.8 * max_accel);
+  const Reference end =
+      selector.safe_stop(100.0 + stop_time + 5.0, at(Vec3::Zero(), Vec3::Zero()), max_accel);
+  EXPECT_NEAR(end.position.x(), 10.0 + 0.5 * 3.0 * stop_time, 1e-9);
+  EXPECT_LT(end.velocity.norm(), 1e-12);
+  EXPECT_LT(end.acceleration.norm(), 1e-12);
+  // Half way, half the speed.
+  const Reference mid = selector.safe_stop(100.0 + 0.5 * stop_time, flown, max_accel);
+  EXPECT_NEAR(mid.velocity.x(), 1.5, 1e-9);
+  // A fresh plan ends the stop; the hand-back ends the avoidance.
+  selector.plan_flown();
+  EXPECT_FALSE(selector.stopping());
+  selector.hand_back();
+  EXPECT_FALSE(selector.avoiding());
+}
+
+}  // namespace
+}  // namespace ofn::control
