@@ -140,8 +140,22 @@ def run_lockstep(build, scenario, out_dir, config_dir=DEFAULT_CONFIG, timeout=LO
 
 
 def flight_ok(rec):
+    """The flight succeeded: its outcome is success and the run did not break."""
     s = rec.get("summary")
     return bool(s and s.get("success") and rec.get("error") is None)
+
+
+def flight_outcome(rec):
+    """"success", "safe_stop" or "failure": the report's outcome; a summary
+    from before the outcome field gives success or failure from its success
+    flag, and a run that broke (or left no summary) is a failure."""
+    s = rec.get("summary")
+    if not s or rec.get("error") is not None:
+        return "failure"
+    outcome = s.get("outcome")
+    if outcome in ("success", "safe_stop", "failure"):
+        return outcome
+    return "success" if s.get("success") else "failure"
 
 
 def process_table(config_dir, out_dir):
@@ -197,6 +211,9 @@ def run_multiprocess(build, scenario, out_dir, rtf, config_dir=DEFAULT_CONFIG):
             log_path = f.read().strip()
         report = [bin_path(build, "ofn_flight_report"), "--log", log_path, "--scenario", scenario,
                   "--out", out_dir]
+        controller_config = os.path.join(config_dir, "controller.yaml")
+        if os.path.isfile(controller_config):  # the controller flew with its defaults otherwise
+            report += ["--controller-config", controller_config]
         proc = subprocess.run(report, capture_output=True, text=True)
         with open(os.path.join(out_dir, "report.txt"), "w") as f:
             f.write(proc.stdout + proc.stderr)

@@ -105,6 +105,7 @@ def fly_field(args, seed, template):
         "seed": seed, "field": field, "obstacles": len(obstacles),
         "tall_obstacles": sum(1 for o in obstacles if random_field.is_tall(o)),
         "success": campaign.flight_ok(rec),
+        "outcome": campaign.flight_outcome(rec),
         "failures": list(s.get("failures") or []) + ([rec["error"]] if rec.get("error") else []),
         "gate_to_gate_s": s.get("gate_to_gate"),
         "min_clearance_over_rs": s["min_clearance"] / rs if rs and s.get("min_clearance") is not None else None,

@@ -87,6 +87,18 @@ def draw_gates(ax, positions, labels=True):
             ax.text(x, 0.98, " " + label, transform=trans, va="top", ha="left", fontsize=8)
 
 
+def verdict_of(summary):
+    """(outcome, first failure line or None) from the summary; a summary
+    written before the outcome field gives success or failure from its
+    success flag, and (None, None) when it has neither."""
+    outcome = summary.get("outcome")
+    if outcome is None and "success" in summary:
+        outcome = "success" if summary["success"] else "failure"
+    failures = summary.get("failures") or []
+    reason = str(failures[0]) if outcome == "failure" and failures else None
+    return outcome, reason
+
+
 def course_gates(summary, k):
     """Gate lines (north coordinate, display unit); either may be null in the summary."""
     gates = summary.get("gates") or {}
@@ -312,6 +324,11 @@ def main():
     title = str(summary.get("scenario", os.path.basename(os.path.abspath(res))))
     if t0 is not None and t1 is not None:
         title += "   gate-to-gate %.1f s" % (t1 - t0)
+    outcome, reason = verdict_of(summary)
+    if outcome:
+        title += "   " + outcome
+    # The first failure line names what went wrong; it gets a line of its own.
+    flight_title = title + ("\n" + reason if reason else "")
 
     fig = plt.figure(figsize=(12, 10))
     gs = fig.add_gridspec(3, 2, height_ratios=[1.2, 1.0, 1.6])
@@ -338,7 +355,7 @@ def main():
     for ax in (ax_top, ax_alt, ax_spd):
         ax.legend(fontsize=7, loc="best", framealpha=0.7)
 
-    fig.suptitle(title, fontsize=14)
+    fig.suptitle(flight_title, fontsize=14, color="firebrick" if outcome == "failure" else "black")
     fig.text(0.99, 0.005, FOOTER, ha="right", va="bottom", fontsize=7, color="0.4")
     fig.tight_layout(rect=(0, 0.02, 1, 0.97))
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)

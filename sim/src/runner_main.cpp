@@ -57,6 +57,10 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "no progress lines");
   app.add_flag("--no-avoidance", no_avoidance,
                "fly without global_planner and rh_optimizer (nominal waypoint guidance only)");
+  app.footer(
+      "Exit code: with --out, 0 when the flight's outcome is success or safe_stop and 1 "
+      "when it is failure; without --out (no report, no verdict), 0 when the vehicle "
+      "arrived and 1 when not; 2 for bad arguments, config or scenario.");
   app.failure_message(CLI::FailureMessage::help);
   CLI11_PARSE(app, argc, argv);
 
@@ -133,10 +137,14 @@ int main(int argc, char** argv) {
     if (!out_dir.empty()) {
       // Close the log before reading it back.
       lockstep.record("/dev/null");
-      const auto result = ofn::report::write_flight_report(log_path, out_dir, scenario);
+      const ofn::report::PseudoControlBound bound{controller_config.gains.max_horizontal_accel,
+                                                  controller_config.gains.max_vertical_accel};
+      const auto result = ofn::report::write_flight_report(log_path, out_dir, scenario, bound);
       std::cout << result.text;
-      if (scenario.finish_gate && !result.summary.crossed_finish) return 1;
+      // A safe stop does not arrive, yet is a proper end of the flight.
+      return result.verdict.outcome == ofn::report::Outcome::kFailure ? 1 : 0;
     }
+    // Without a report there is no verdict; arrival is all there is to go by.
     return arrived ? 0 : 1;
   });
 }

@@ -21,9 +21,11 @@ for ch in SCAN_WORLD OBSTACLE_GRID CUBOIDS GLOBAL_PATH REF_TRAJ SOLVER_STATS; do
 done
 grep -q "replay reproduces the recording" "$WORK/replay.txt" || fail "no verdict line"
 
-# The replayed log is a flight log like any other.
+# The replayed log is a flight log like any other. Cut off at 25 s the
+# flight's outcome is failure (exit 1); only a report that broke fails here.
 "$BIN/ofn_flight_report" --log "$WORK/replay/replayed.lcm" --scenario "$scenario" \
-  --out "$WORK/replay/report" > /dev/null || fail "flight report of the replayed log failed"
+  --out "$WORK/replay/report" > /dev/null || [[ $? == 1 ]] ||
+  fail "flight report of the replayed log failed"
 cmp "$WORK/orig/ref_traj.csv" "$WORK/replay/report/ref_traj.csv" || fail "REF_TRAJ CSV differs"
 cmp "$WORK/orig/global_path.csv" "$WORK/replay/report/global_path.csv" ||
   fail "GLOBAL_PATH CSV differs"

@@ -1,4 +1,5 @@
-// Flight figures of merit: gate timing, speeds and tracking error.
+// Flight figures of merit (gate timing, speeds, tracking error, the
+// controller's command and the reference's continuity) and the verdict.
 
 #include <gtest/gtest.h>
 
@@ -172,14 +173,25 @@ Limits judged_limits() {
   return l;
 }
 
-/// A flight inside every limit that crossed the finish gate.
+/// The controller's pseudo-control bound (config/controller.yaml).
+PseudoControlBound bound() {
+  return {5.0, 3.0};
+}
+
+/// A flight inside every limit that crossed the finish gate and reached
+/// the last waypoint.
 FlightSummary clean_flight() {
   FlightSummary s;
   s.crossed_finish = true;
+  s.reached_last_waypoint = true;
   s.max_speed = 12.0;
   s.max_vertical_speed = 2.0;
   s.max_commanded_accel_fraction = 1.0;
+  s.max_pseudo_control_horizontal = 5.0;
+  s.max_pseudo_control_vertical = 3.0;
+  s.max_ref_position_jump = kMaxReferenceJump;
   s.min_forward_speed = 0.0;
+  s.final_max_speed = 0.0;
   return s;
 }
 
@@ -190,13 +202,19 @@ bool names(const Verdict& v, const std::string& text) {
 }
 
 TEST(JudgeFlight, AFlightAtTheLimitsSucceeds) {
-  const Verdict v = judge_flight(clean_flight(), judged_limits(), 0.8 * 6.096, true);
+  const Verdict v = judge_flight(clean_flight(), judged_limits(), bound(), 0.8 * 6.096, true);
   EXPECT_TRUE(v.success);
+  EXPECT_EQ(v.outcome, Outcome::kSuccess);
   EXPECT_TRUE(v.failures.empty());
-  // No obstacles and no gates: limits alone.
+  // No obstacles and no gates: the last waypoint is the goal.
   FlightSummary no_gate = clean_flight();
   no_gate.crossed_finish = false;
-  EXPECT_TRUE(judge_flight(no_gate, judged_limits(), std::nullopt, false).success);
+  EXPECT_TRUE(judge_flight(no_gate, judged_limits(), bound(), std::nullopt, false).success);
+  no_gate.reached_last_waypoint = false;
+  no_gate.final_max_speed = 1.0;
+  const Verdict short_of_it = judge_flight(no_gate, judged_limits(), bound(), std::nullopt, false);
+  EXPECT_EQ(short_of_it.outcome, Outcome::kFailure);
+  EXPECT_TRUE(names(short_of_it, "did not reach the last waypoint"));
 }
 
 TEST(JudgeFlight, EachRuleFailsJustBeyondItsToleranceAndIsNamed) {
@@ -217,11 +235,27 @@ TEST(JudgeFlight, EachRuleFailsJustBeyondItsToleranceAndIsNamed) {
          s.max_vertical_speed = lim.max_vertical_speed * (beyond ? 1.021 : 1.019);
        },
        "vertical speed"},
-      {"commanded acceleration",
+      {"reference acceleration",
        [](FlightSummary& s, const Limits&, bool beyond) {
          s.max_commanded_accel_fraction = beyond ? 1.021 : 1.019;
        },
-       "commanded acceleration"},
+       "reference acceleration"},
+      {"horizontal pseudo-control",
+       [](FlightSummary& s, const Limits&, bool beyond) {
+         s.max_pseudo_control_horizontal = bound().horizontal * (beyond ? 1.021 : 1.019);
+       },
+       "controller command out of its bound: horizontal"},
+      {"vertical pseudo-control",
+       [](FlightSummary& s, const Limits&, bool beyond) {
+         s.max_pseudo_control_vertical = bound().vertical * (beyond ? 1.021 : 1.019);
+       },
+       "controller command out of its bound: vertical"},
+      {"reference jump",
+       [](FlightSummary& s, const Limits&, bool beyond) {
+         s.max_ref_position_jump = kMaxReferenceJump * (beyond ? 1.01 : 0.99);
+         s.max_ref_position_jump_t = 12.0;
+       },
+       "reference jump"},
       {"backwards",
        [](FlightSummary& s, const Limits& lim, bool beyond) {
          s.min_forward_speed = -lim.max_speed * (beyond ? 0.021 : 0.019);
@@ -231,10 +265,10 @@ TEST(JudgeFlight, EachRuleFailsJustBeyondItsToleranceAndIsNamed) {
   for (const Case& c : cases) {
     FlightSummary inside = clean_flight();
     c.spoil(inside, l, false);
-    EXPECT_TRUE(judge_flight(inside, l, 10.0, true).success) << c.name;
+    EXPECT_TRUE(judge_flight(inside, l, bound(), 10.0, true).success) << c.name;
     FlightSummary beyond = clean_flight();
     c.spoil(beyond, l, true);
-    const Verdict v = judge_flight(beyond, l, 10.0, true);
+    const Verdict v = judge_flight(beyond, l, bound(), 10.0, true);
     EXPECT_FALSE(v.success) << c.name;
     ASSERT_EQ(v.failures.size(), 1u) << c.name;
     EXPECT_TRUE(names(v, c.named)) << c.name << ": " << v.failures.front();
@@ -244,21 +278,278 @@ TEST(JudgeFlight, EachRuleFailsJustBeyondItsToleranceAndIsNamed) {
 TEST(JudgeFlight, ClearanceBelowEightTenthsOfRsAndAMissedGateFail) {
   const Limits l = judged_limits();
   // Inside R_s but not below 0.8 R_s: allowed.
-  EXPECT_TRUE(judge_flight(clean_flight(), l, 0.81 * l.clearance, true).success);
-  const Verdict close = judge_flight(clean_flight(), l, 0.79 * l.clearance, true);
+  EXPECT_TRUE(judge_flight(clean_flight(), l, bound(), 0.81 * l.clearance, true).success);
+  const Verdict close = judge_flight(clean_flight(), l, bound(), 0.79 * l.clearance, true);
   EXPECT_FALSE(close.success);
   EXPECT_TRUE(names(close, "clearance"));
 
   FlightSummary short_run = clean_flight();
   short_run.crossed_finish = false;
   short_run.max_speed = 2.0 * l.max_speed;
-  const Verdict v = judge_flight(short_run, l, 0.5 * l.clearance, true);
+  const Verdict v = judge_flight(short_run, l, bound(), 0.5 * l.clearance, true);
   EXPECT_FALSE(v.success);
   // Every broken rule is reported, not only the first.
   EXPECT_EQ(v.failures.size(), 3u);
   EXPECT_TRUE(names(v, "missed the finish gate"));
   EXPECT_TRUE(names(v, "clearance"));
   EXPECT_TRUE(names(v, "speed (m/s) over"));
+}
+
+// ---------------------------------------------------------------------------
+// Three outcomes: success, safe stop (short of the goal, nothing broken,
+// hovering at the end), failure.
+
+TEST(JudgeFlight, OutcomeWordsAreTheReportsWords) {
+  EXPECT_STREQ(to_string(Outcome::kSuccess), "success");
+  EXPECT_STREQ(to_string(Outcome::kSafeStop), "safe_stop");
+  EXPECT_STREQ(to_string(Outcome::kFailure), "failure");
+}
+
+TEST(JudgeFlight, AHoverShortOfTheGoalWithNothingBrokenIsASafeStop) {
+  const Limits l = judged_limits();
+  FlightSummary stopped = clean_flight();
+  stopped.crossed_finish = false;
+  stopped.reached_last_waypoint = false;
+  stopped.final_max_speed = 0.9 * kHoverSpeed;
+  const Verdict v = judge_flight(stopped, l, bound(), l.clearance, true);
+  EXPECT_EQ(v.outcome, Outcome::kSafeStop);
+  EXPECT_FALSE(v.success);
+  EXPECT_TRUE(v.failures.empty());
+}
+
+TEST(JudgeFlight, ShortOfTheGoalAndStillMovingIsAFailure) {
+  const Limits l = judged_limits();
+  FlightSummary drifting = clean_flight();
+  drifting.crossed_finish = false;
+  drifting.reached_last_waypoint = false;
+  drifting.final_max_speed = 1.1 * kHoverSpeed;
+  const Verdict v = judge_flight(drifting, l, bound(), l.clearance, true);
+  EXPECT_EQ(v.outcome, Outcome::kFailure);
+  EXPECT_FALSE(v.success);
+  ASSERT_EQ(v.failures.size(), 1u);
+  EXPECT_TRUE(names(v, "missed the finish gate and did not end at a hover")) << v.failures[0];
+  // Too little data to tell a hover is not a hover.
+  drifting.final_max_speed.reset();
+  EXPECT_EQ(judge_flight(drifting, l, bound(), l.clearance, true).outcome, Outcome::kFailure);
+}
+
+TEST(JudgeFlight, AHoverShortOfTheGoalWithARuleBrokenIsAFailure) {
+  const Limits l = judged_limits();
+  FlightSummary stopped = clean_flight();
+  stopped.crossed_finish = false;
+  stopped.reached_last_waypoint = false;
+  stopped.final_max_speed = 0.0;
+  stopped.max_speed = 1.1 * l.max_speed;
+  const Verdict v = judge_flight(stopped, l, bound(), l.clearance, true);
+  EXPECT_EQ(v.outcome, Outcome::kFailure);
+  EXPECT_TRUE(names(v, "speed"));
+  EXPECT_TRUE(names(v, "missed the finish gate"));
+  // The goal reached with a rule broken is no success either.
+  FlightSummary fast = clean_flight();
+  fast.max_speed = 1.1 * l.max_speed;
+  EXPECT_EQ(judge_flight(fast, l, bound(), l.clearance, true).outcome, Outcome::kFailure);
+}
+
+TEST(JudgeFlight, FailureLinesUseTheDisplayUnit) {
+  const Limits l = judged_limits();  // R_s 6.096 m = 20 ft
+  const Verdict v =
+      judge_flight(clean_flight(), l, bound(), 0.5 * l.clearance, true, DisplayUnit{"ft", 0.3048});
+  ASSERT_EQ(v.failures.size(), 1u);
+  EXPECT_EQ(v.failures[0], "clearance (ft) below 0.8 R_s: 10 against 16");
+}
+
+TEST(AnalyseFlight, FinalSpeedIsTheLargestOverTheLastTwoSeconds) {
+  // 10 m/s, then a hover over the last 2 s (10 Hz samples).
+  std::vector<NavSample> samples;
+  for (int i = 0; i <= 100; ++i)
+    samples.push_back(nav(0.1 * i, 1.0 * i, i < 80 ? Vec3(10, 0, 0) : Vec3(0.1, 0, -0.05)));
+  FlightSummary s = analyse_flight(samples, {}, limits(), std::nullopt, std::nullopt);
+  ASSERT_TRUE(s.final_max_speed.has_value());
+  EXPECT_NEAR(*s.final_max_speed, std::hypot(0.1, 0.05), 1e-12);
+  // One fast sample inside the window counts.
+  samples[81].velocity = Vec3(0, 0.5, 0);
+  s = analyse_flight(samples, {}, limits(), std::nullopt, std::nullopt);
+  EXPECT_NEAR(*s.final_max_speed, 0.5, 1e-12);
+  // Shorter than the window: no figure.
+  samples.resize(15);
+  EXPECT_FALSE(analyse_flight(samples, {}, limits(), std::nullopt, std::nullopt)
+                   .final_max_speed.has_value());
+}
+
+// ---------------------------------------------------------------------------
+// The ground is a surface like any obstacle.
+
+/// Level at 30 m altitude for 10 s, then down at 2 m/s into the ground at
+/// altitude 0 and sitting there (10 Hz samples).
+std::vector<NavSample> descent_into_the_ground() {
+  std::vector<NavSample> out;
+  for (int i = 0; i <= 300; ++i) {
+    const double t = 0.1 * i;
+    const double altitude = t < 10 ? 30.0 : std::max(30.0 - 2.0 * (t - 10), 0.0);
+    NavSample n = nav(t, 5.0 * t, Vec3(5, 0, altitude > 0 && t >= 10 ? 2.0 : 0.0));
+    n.position.z() = -altitude;
+    out.push_back(n);
+  }
+  return out;
+}
+
+TEST(LeastClearance, CountsTheGround) {
+  const auto samples = descent_into_the_ground();
+  const world::World flat({}, 0.0);
+  const auto c = least_clearance(samples, flat);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->distance, 0.0, 1e-12);
+  EXPECT_TRUE(c->to_ground);
+  EXPECT_NEAR(c->t, 25.0, 1e-9);  // the first sample on the ground
+  // The same flight over ground 10 m lower keeps 10 m.
+  const auto lower = least_clearance(samples, world::World({}, -10.0));
+  ASSERT_TRUE(lower.has_value());
+  EXPECT_NEAR(lower->distance, 10.0, 1e-9);
+  EXPECT_FALSE(least_clearance({}, flat).has_value());
+}
+
+TEST(LeastClearance, TheNearerSurfaceCounts) {
+  // Level at 30 m; a box 20 m high whose top passes 10 m below the path.
+  const std::vector<NavSample> samples = {nav(0, 0), nav(1, 10), nav(2, 20)};
+  ObstacleSpec box;
+  box.id = 1;
+  box.kind = ObstacleSpec::Kind::kBox;
+  box.north = 10;
+  box.east = 0;
+  box.length = 4;
+  box.width = 4;
+  box.height = 20;
+  const auto c = least_clearance(samples, world::World({box}, 0.0));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->distance, 10.0, 1e-9);
+  EXPECT_FALSE(c->to_ground);
+  EXPECT_NEAR(c->t, 1.0, 1e-12);
+}
+
+TEST(JudgeFlight, AFlightIntoTheGroundFails) {
+  const Limits l = judged_limits();
+  const auto samples = descent_into_the_ground();
+  const FlightSummary s = analyse_flight(samples, {}, l, std::nullopt, std::nullopt);
+  const auto c = least_clearance(samples, world::World({}, 0.0));
+  ASSERT_TRUE(c.has_value());
+  const Verdict v = judge_flight(s, l, bound(), c->distance, false);
+  EXPECT_EQ(v.outcome, Outcome::kFailure);
+  EXPECT_TRUE(names(v, "clearance"));
+}
+
+// ---------------------------------------------------------------------------
+// The controller's command against its bound, and the reference's
+// continuity, from CONTROL_STATUS samples.
+
+/// A plan flown at 50 Hz for 4 s: the reference moves north at 3 m/s.
+std::vector<StatusSample> plan_at_three_metres_per_second() {
+  std::vector<StatusSample> out;
+  for (int i = 0; i <= 200; ++i) {
+    StatusSample st = status(0.02 * i, control_status_t::WAYPOINT, Vec3(0.1, 0, 0), Vec3::Zero(),
+                             Vec3(0.5, 0, -0.2));
+    st.ref_position = Vec3(3.0 * st.t, 0, -30);
+    st.ref_velocity = Vec3(3, 0, 0);
+    out.push_back(st);
+  }
+  return out;
+}
+
+FlightSummary analysed(const std::vector<StatusSample>& st) {
+  return analyse_flight(straight_run(), st, limits(), 0.0, 400.0);
+}
+
+Verdict judged(const FlightSummary& s) {
+  return judge_flight(s, judged_limits(), bound(), 10.0, true);
+}
+
+TEST(AnalyseFlight, ASmoothPlanHasNoReferenceJumpAndPasses) {
+  const FlightSummary s = analysed(plan_at_three_metres_per_second());
+  EXPECT_NEAR(s.max_ref_position_jump, 0.0, 1e-9);
+  EXPECT_NEAR(s.max_ref_velocity_jump, 0.0, 1e-9);
+  EXPECT_NEAR(s.max_pseudo_control_horizontal, 0.5, 1e-12);
+  EXPECT_NEAR(s.max_pseudo_control_vertical, 0.2, 1e-12);
+  const Verdict v = judged(s);
+  EXPECT_EQ(v.outcome, Outcome::kSuccess) << (v.failures.empty() ? "" : v.failures[0]);
+}
+
+TEST(AnalyseFlight, AMissingSampleIsNoJump) {
+  auto st = plan_at_three_metres_per_second();
+  st.erase(st.begin() + 50, st.begin() + 100);  // a second without status
+  EXPECT_NEAR(analysed(st).max_ref_position_jump, 0.0, 1e-9);
+}
+
+TEST(JudgeFlight, AReferenceJumpFails) {
+  auto st = plan_at_three_metres_per_second();
+  // From sample 120 on the reference is 1.5 m further east: a step.
+  for (size_t i = 120; i < st.size(); ++i) st[i].ref_position.y() += 1.5;
+  const FlightSummary s = analysed(st);
+  EXPECT_NEAR(s.max_ref_position_jump, 1.5, 1e-9);
+  ASSERT_TRUE(s.max_ref_position_jump_t.has_value());
+  EXPECT_NEAR(*s.max_ref_position_jump_t, 2.4, 1e-12);
+  const Verdict v = judged(s);
+  EXPECT_EQ(v.outcome, Outcome::kFailure);
+  EXPECT_TRUE(names(v, "reference jump"));
+  // A step of the velocity is measured too (its limit is the acceleration).
+  st = plan_at_three_metres_per_second();
+  for (size_t i = 120; i < st.size(); ++i) st[i].ref_velocity.x() += 2.0;
+  EXPECT_NEAR(analysed(st).max_ref_velocity_jump, 2.0, 1e-9);
+}
+
+TEST(JudgeFlight, APseudoControlOverItsBoundFails) {
+  auto st = plan_at_three_metres_per_second();
+  st[150].commanded_accel = Vec3(4.0, 3.2, 0.0);  // 5.12 horizontal, bound 5 + 2 %
+  FlightSummary s = analysed(st);
+  EXPECT_NEAR(s.max_pseudo_control_horizontal, std::hypot(4.0, 3.2), 1e-12);
+  Verdict v = judged(s);
+  EXPECT_EQ(v.outcome, Outcome::kFailure);
+  EXPECT_TRUE(names(v, "controller command out of its bound: horizontal"));
+
+  st = plan_at_three_metres_per_second();
+  st[150].commanded_accel = Vec3(0.0, 0.0, -3.1);  // up, bound 3 + 2 %
+  s = analysed(st);
+  EXPECT_NEAR(s.max_pseudo_control_vertical, 3.1, 1e-12);
+  v = judged(s);
+  EXPECT_EQ(v.outcome, Outcome::kFailure);
+  EXPECT_TRUE(names(v, "controller command out of its bound: vertical"));
+}
+
+TEST(AnalyseFlight, SamplesBeforeEngagementAreIgnored) {
+  // A hold somewhere else with a large command, then the plan: the step
+  // from the hold's reference to the plan's and the hold's command are not
+  // the plan's.
+  std::vector<StatusSample> st;
+  for (int i = 0; i < 50; ++i) {
+    StatusSample hold = status(-1.0 + 0.02 * i, control_status_t::HOLD, Vec3(5, 0, 0),
+                               Vec3(3, 0, 0), Vec3(9, 0, 7));
+    hold.ref_position = Vec3(-200, 40, -60);
+    hold.ref_velocity = Vec3::Zero();
+    st.push_back(hold);
+  }
+  const auto plan = plan_at_three_metres_per_second();
+  st.insert(st.end(), plan.begin(), plan.end());
+  const FlightSummary s = analysed(st);
+  EXPECT_NEAR(s.max_ref_position_jump, 0.0, 1e-9);
+  EXPECT_NEAR(s.max_pseudo_control_horizontal, 0.5, 1e-12);
+  EXPECT_NEAR(s.max_pseudo_control_vertical, 0.2, 1e-12);
+  EXPECT_NEAR(s.max_commanded_accel, 0.0, 1e-12);
+  EXPECT_NEAR(s.tracking_max, 0.1, 1e-12);
+  const Verdict v = judged(s);
+  EXPECT_EQ(v.outcome, Outcome::kSuccess) << (v.failures.empty() ? "" : v.failures[0]);
+  // The same hold samples flown as a plan would fail on both counts.
+  for (int i = 0; i < 50; ++i) st[i].mode = control_status_t::WAYPOINT;
+  const Verdict engaged = judged(analysed(st));
+  EXPECT_TRUE(names(engaged, "reference jump"));
+  EXPECT_TRUE(names(engaged, "controller command out of its bound"));
+}
+
+TEST(AnalyseFlight, AModeAddedLaterToFlyAPlanIsJudged) {
+  EXPECT_TRUE(flies_a_plan(control_status_t::WAYPOINT));
+  EXPECT_TRUE(flies_a_plan(control_status_t::TRAJECTORY));
+  EXPECT_FALSE(flies_a_plan(control_status_t::HOLD));
+  EXPECT_FALSE(flies_a_plan(control_status_t::NAV_STALE));
+  EXPECT_FALSE(flies_a_plan(control_status_t::DONE));
+  constexpr int kUnknownMode = 42;
+  EXPECT_TRUE(flies_a_plan(kUnknownMode));
 }
 
 }  // namespace

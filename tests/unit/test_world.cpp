@@ -271,6 +271,15 @@ TEST(WorldGround, OnlyDownwardRaysHitTheGround) {
   EXPECT_TRUE(std::isinf(w.distance_to_obstacles(Vec3(0, 0, -30))));
 }
 
+TEST(WorldGround, DistanceToTheGroundIsTheHeightAboveIt) {
+  World w({}, 5.0);  // ground at altitude 5: z = -5
+  EXPECT_NEAR(w.distance_to_ground(Vec3(3, 4, -30)), 25.0, 1e-12);
+  EXPECT_DOUBLE_EQ(w.distance_to_ground(Vec3(0, 0, -5)), 0.0);
+  EXPECT_DOUBLE_EQ(w.distance_to_ground(Vec3(0, 0, 2)), 0.0);  // below the surface
+  w.set_ground_altitude(-10.0);
+  EXPECT_NEAR(w.distance_to_ground(Vec3(3, 4, -30)), 40.0, 1e-12);
+}
+
 TEST(WorldGround, ObstaclesStandOnTheGroundAndMoveWithIt) {
   World w({box(3, 10, 0, 2, 2, 5)}, 10.0);
   EXPECT_NEAR(w.obstacles()[0].bounds_min().z(), -15.0, 1e-12);

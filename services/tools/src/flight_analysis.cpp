@@ -1,5 +1,6 @@
 #include "ofn/tools/flight_analysis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -18,6 +19,14 @@ std::optional<double> crossing_time(const std::vector<NavSample>& nav, double x)
   return std::nullopt;  // never crossed, or started past the line
 }
 
+bool flies_a_plan(int mode) {
+  // A deny list rather than WAYPOINT and TRAJECTORY alone: a mode added
+  // later in which the controller flies (a planned stop, say) is judged
+  // like the others instead of passing unseen.
+  return mode != control_status_t::HOLD && mode != control_status_t::NAV_STALE &&
+         mode != control_status_t::DONE;
+}
+
 FlightSummary analyse_flight(const std::vector<NavSample>& nav,
                              const std::vector<StatusSample>& status, const Limits& limits,
                              std::optional<double> start_gate, std::optional<double> finish_gate) {
@@ -26,6 +35,12 @@ FlightSummary analyse_flight(const std::vector<NavSample>& nav,
   for (const auto& n : nav) {
     s.max_speed = std::max(s.max_speed, n.velocity.norm());
     s.max_vertical_speed = std::max(s.max_vertical_speed, std::abs(n.velocity.z()));
+  }
+  if (!nav.empty() && s.duration >= kHoverWindow) {
+    double final_max = 0;
+    for (auto it = nav.rbegin(); it != nav.rend() && it->t >= nav.back().t - kHoverWindow; ++it)
+      final_max = std::max(final_max, it->velocity.norm());
+    s.final_max_speed = final_max;
   }
   if (start_gate) s.gate_start_time = crossing_time(nav, *start_gate);
   if (finish_gate) {
@@ -44,12 +59,36 @@ FlightSummary analyse_flight(const std::vector<NavSample>& nav,
 
   double sum_sq = 0;
   size_t count = 0;
+  const StatusSample* previous = nullptr;  // the last sample, if it flew the plan
   for (const auto& st : status) {
     if (st.mode == control_status_t::DONE) s.reached_last_waypoint = true;
-    // Only the part of the flight where a plan is flown counts.
-    if (st.mode != control_status_t::WAYPOINT && st.mode != control_status_t::TRAJECTORY) continue;
+    // Only the part of the flight where a plan is flown counts: before the
+    // controller engages, the reference and the command are a hold's.
+    if (!flies_a_plan(st.mode)) {
+      previous = nullptr;
+      continue;
+    }
     s.max_commanded_accel = std::max(s.max_commanded_accel, st.ref_acceleration.norm());
     s.max_pseudo_control = std::max(s.max_pseudo_control, st.commanded_accel.norm());
+    s.max_pseudo_control_horizontal =
+        std::max(s.max_pseudo_control_horizontal, st.commanded_accel.head<2>().norm());
+    s.max_pseudo_control_vertical =
+        std::max(s.max_pseudo_control_vertical, std::abs(st.commanded_accel.z()));
+    if (previous) {
+      const double dt = st.t - previous->t;
+      const double position_jump = (st.ref_position - previous->ref_position -
+                                    0.5 * dt * (st.ref_velocity + previous->ref_velocity))
+                                       .norm();
+      const double velocity_jump = (st.ref_velocity - previous->ref_velocity -
+                                    0.5 * dt * (st.ref_acceleration + previous->ref_acceleration))
+                                       .norm();
+      if (position_jump > s.max_ref_position_jump) {
+        s.max_ref_position_jump = position_jump;
+        s.max_ref_position_jump_t = st.t;
+      }
+      s.max_ref_velocity_jump = std::max(s.max_ref_velocity_jump, velocity_jump);
+    }
+    previous = &st;
     const double e = st.position_error.norm();
     s.tracking_max = std::max(s.tracking_max, e);
     sum_sq += e * e;
@@ -61,32 +100,99 @@ FlightSummary analyse_flight(const std::vector<NavSample>& nav,
   return s;
 }
 
+const char* to_string(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kSuccess:
+      return "success";
+    case Outcome::kSafeStop:
+      return "safe_stop";
+    case Outcome::kFailure:
+      return "failure";
+  }
+  return "failure";
+}
+
 Verdict judge_flight(const FlightSummary& s, const Limits& limits,
-                     std::optional<double> min_clearance, bool has_finish_gate) {
+                     const PseudoControlBound& pseudo_control_bound,
+                     std::optional<double> min_clearance, bool has_finish_gate,
+                     const DisplayUnit& unit) {
   Verdict v;
+  // The figures are SI; the lines give lengths in the display unit.
+  const double per_metre = 1.0 / unit.metres_per_unit;
   const auto fail = [&v](const std::string& what, double value, double bound) {
     std::ostringstream line;
     line.precision(3);
     line << what << ": " << value << " against " << bound;
     v.failures.push_back(line.str());
   };
+  const std::string& u = unit.name;
   const double over = 1.0 + kLimitTolerance;
-  if (has_finish_gate && !s.crossed_finish) v.failures.push_back("missed the finish gate");
   if (min_clearance && *min_clearance < kClearanceFailShare * limits.clearance)
-    fail("clearance (m) below 0.8 R_s", *min_clearance, kClearanceFailShare * limits.clearance);
+    fail("clearance (" + u + ") below 0.8 R_s", *min_clearance * per_metre,
+         kClearanceFailShare * limits.clearance * per_metre);
   if (s.max_speed > over * limits.max_speed)
-    fail("speed (m/s) over the limit + 2 %", s.max_speed, over * limits.max_speed);
+    fail("speed (" + u + "/s) over the limit + 2 %", s.max_speed * per_metre,
+         over * limits.max_speed * per_metre);
   if (s.max_vertical_speed > over * limits.max_vertical_speed)
-    fail("vertical speed (m/s) over the limit + 2 %", s.max_vertical_speed,
-         over * limits.max_vertical_speed);
+    fail("vertical speed (" + u + "/s) over the limit + 2 %", s.max_vertical_speed * per_metre,
+         over * limits.max_vertical_speed * per_metre);
   if (s.max_commanded_accel_fraction > over)
-    fail("commanded acceleration (share of the limit) over 1.02", s.max_commanded_accel_fraction,
+    fail("reference acceleration (share of the limit) over 1.02", s.max_commanded_accel_fraction,
          over);
   if (s.min_forward_speed < -kLimitTolerance * limits.max_speed)
-    fail("forward speed (m/s) below -2 % of the speed limit", s.min_forward_speed,
-         -kLimitTolerance * limits.max_speed);
-  v.success = v.failures.empty();
+    fail("forward speed (" + u + "/s) below -2 % of the speed limit",
+         s.min_forward_speed * per_metre, -kLimitTolerance * limits.max_speed * per_metre);
+  if (s.max_pseudo_control_horizontal > over * pseudo_control_bound.horizontal)
+    fail("controller command out of its bound: horizontal pseudo-control (" + u +
+             "/s^2) over the bound + 2 %",
+         s.max_pseudo_control_horizontal * per_metre,
+         over * pseudo_control_bound.horizontal * per_metre);
+  if (s.max_pseudo_control_vertical > over * pseudo_control_bound.vertical)
+    fail("controller command out of its bound: vertical pseudo-control (" + u +
+             "/s^2) over the bound + 2 %",
+         s.max_pseudo_control_vertical * per_metre,
+         over * pseudo_control_bound.vertical * per_metre);
+  if (s.max_ref_position_jump > kMaxReferenceJump) {
+    std::ostringstream what;
+    what.precision(3);
+    what << "reference jump (" << u
+         << ") between consecutive samples at t = " << s.max_ref_position_jump_t.value_or(0.0)
+         << " s";
+    fail(what.str(), s.max_ref_position_jump * per_metre, kMaxReferenceJump * per_metre);
+  }
+
+  const bool goal_reached = has_finish_gate ? s.crossed_finish : s.reached_last_waypoint;
+  const bool ends_at_hover = s.final_max_speed && *s.final_max_speed < kHoverSpeed;
+  if (!goal_reached && !(v.failures.empty() && ends_at_hover)) {
+    std::ostringstream line;
+    line.precision(3);
+    line << (has_finish_gate ? "missed the finish gate" : "did not reach the last waypoint");
+    if (!ends_at_hover) {
+      line << " and did not end at a hover";
+      if (s.final_max_speed)
+        line << " (speed up to " << *s.final_max_speed * per_metre << " " << u
+             << "/s over the last " << kHoverWindow << " s)";
+    }
+    v.failures.push_back(line.str());
+  }
+  if (!v.failures.empty())
+    v.outcome = Outcome::kFailure;
+  else
+    v.outcome = goal_reached ? Outcome::kSuccess : Outcome::kSafeStop;
+  v.success = v.outcome == Outcome::kSuccess;
   return v;
+}
+
+std::optional<Clearance> least_clearance(const std::vector<NavSample>& nav,
+                                         const world::World& truth) {
+  std::optional<Clearance> least;
+  for (const auto& n : nav) {
+    const double to_obstacle = truth.distance_to_obstacles(n.position, n.t);
+    const double to_ground = truth.distance_to_ground(n.position);
+    const double d = std::min(to_obstacle, to_ground);
+    if (!least || d < least->distance) least = Clearance{d, n.t, to_ground <= to_obstacle};
+  }
+  return least;
 }
 
 }  // namespace ofn::report

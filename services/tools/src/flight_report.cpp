@@ -73,7 +73,8 @@ std::string json_number(std::optional<double> v) {
 }  // namespace
 
 ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
-                                 const std::optional<Scenario>& scenario) {
+                                 const std::optional<Scenario>& scenario,
+                                 const PseudoControlBound& pseudo_control_bound) {
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::runtime_error("cannot read LCM log " + log_path);
   namespace fs = std::filesystem;
@@ -262,29 +263,23 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
                    << c.max_corner[1] << "," << c.max_corner[2] << "," << (c.top_observed ? 1 : 0)
                    << "," << c.confidence << "\n";
   }
-  // True clearance: distance from the flown path to the real obstacle
-  // surfaces (present at that time), over the whole flight.
-  std::optional<double> min_clearance;
-  std::optional<double> min_clearance_t;
-  if (scenario && !scenario->obstacles.empty()) {
-    const world::World truth(scenario->obstacles, scenario->ground_altitude);
-    for (const auto& n : nav) {
-      const double d = truth.distance_to_obstacles(n.position, n.t);
-      if (!min_clearance || d < *min_clearance) {
-        min_clearance = d;
-        min_clearance_t = n.t;
-      }
-    }
-  }
+  // True clearance: distance from the flown path to the real surfaces, the
+  // obstacles present at that time and the ground, over the whole flight.
+  std::optional<Clearance> clearance;
+  if (scenario)
+    clearance = least_clearance(nav, world::World(scenario->obstacles, scenario->ground_altitude));
+  const std::optional<double> min_clearance =
+      clearance ? std::optional<double>(clearance->distance) : std::nullopt;
   result.min_clearance = min_clearance;
   const auto start_gate = scenario ? scenario->start_gate : std::nullopt;
   const auto finish_gate = scenario ? scenario->finish_gate : std::nullopt;
   result.summary = analyse_flight(nav, status, limits, start_gate, finish_gate);
   const FlightSummary& s = result.summary;
-  result.verdict = judge_flight(s, limits, min_clearance, finish_gate.has_value());
 
   const std::string unit = scenario ? scenario->display_unit : "m";
   const double k = scenario ? scenario->metres_per_unit : 1.0;
+  result.verdict = judge_flight(s, limits, pseudo_control_bound, min_clearance,
+                                finish_gate.has_value(), DisplayUnit{unit, k});
   const std::string name = scenario ? scenario->name : (mission ? mission->name : "flight");
 
   std::ofstream json(out / "summary.json");
@@ -310,10 +305,20 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"max_commanded_accel\": " << s.max_commanded_accel << ",\n"
        << "  \"max_commanded_accel_fraction\": " << s.max_commanded_accel_fraction << ",\n"
        << "  \"max_pseudo_control\": " << s.max_pseudo_control << ",\n"
+       << "  \"max_pseudo_control_horizontal\": " << s.max_pseudo_control_horizontal << ",\n"
+       << "  \"max_pseudo_control_vertical\": " << s.max_pseudo_control_vertical << ",\n"
+       << "  \"pseudo_control_bound\": {\"horizontal\": " << pseudo_control_bound.horizontal
+       << ", \"vertical\": " << pseudo_control_bound.vertical << "},\n"
+       << "  \"max_ref_position_jump\": " << s.max_ref_position_jump << ",\n"
+       << "  \"max_ref_position_jump_t\": " << json_number(s.max_ref_position_jump_t) << ",\n"
+       << "  \"max_ref_velocity_jump\": " << s.max_ref_velocity_jump << ",\n"
+       << "  \"final_max_speed\": " << json_number(s.final_max_speed) << ",\n"
        << "  \"tracking_rms\": " << s.tracking_rms << ",\n"
        << "  \"tracking_max\": " << s.tracking_max << ",\n"
        << "  \"min_clearance\": " << json_number(min_clearance) << ",\n"
-       << "  \"min_clearance_t\": " << json_number(min_clearance_t) << ",\n"
+       << "  \"min_clearance_t\": " << (clearance ? json_number(clearance->t) : "null") << ",\n"
+       << "  \"min_clearance_surface\": "
+       << (clearance ? (clearance->to_ground ? "\"ground\"" : "\"obstacle\"") : "null") << ",\n"
        << "  \"clearance_required\": " << limits.clearance << ",\n"
        << "  \"rh_steps\": " << solve_times.size() << ",\n"
        << "  \"rh_solve_time_median\": " << json_number(percentile(solve_times, 0.5)) << ",\n"
@@ -322,6 +327,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"rh_kept_previous\": " << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ",\n"
        << "  \"rh_braking\": " << solver_status_count[solver_stats_t::BRAKING] << ",\n"
        << "  \"rh_deferred\": " << solver_status_count[solver_stats_t::DEFERRED] << ",\n"
+       << "  \"outcome\": \"" << to_string(result.verdict.outcome) << "\",\n"
        << "  \"success\": " << (result.verdict.success ? "true" : "false") << ",\n"
        << "  \"failures\": [";
   for (size_t i = 0; i < result.verdict.failures.size(); ++i)
@@ -352,9 +358,20 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   if (finish_gate)
     t << (s.crossed_finish ? ", crossed the finish gate" : ", did NOT cross the finish gate");
   t << "\n";
-  t << "  verdict           : "
-    << (result.verdict.success ? "success (gate, 0.8 R_s clearance, limits within 2 %)" : "FAILED");
-  for (const auto& f : result.verdict.failures) t << "\n                      " << f;
+  t << "  outcome           : " << to_string(result.verdict.outcome);
+  switch (result.verdict.outcome) {
+    case Outcome::kSuccess:
+      t << " (goal reached, no rule broken)";
+      break;
+    case Outcome::kSafeStop:
+      t << " (goal not reached, no rule broken, hovering at the end: at most "
+        << s.final_max_speed.value_or(0.0) / k << " " << unit << "/s over the last " << kHoverWindow
+        << " s)";
+      break;
+    case Outcome::kFailure:
+      for (const auto& f : result.verdict.failures) t << "\n                      " << f;
+      break;
+  }
   t << "\n";
   if (s.gate_to_gate)
     t << "  gate-to-gate time : " << *s.gate_to_gate << " s (x = " << *start_gate / k << " -> "
@@ -363,18 +380,24 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     t << "  gate-to-gate time : n/a (a gate was not crossed)\n";
   t << "  max speed         : " << s.max_speed / k << " " << unit << "/s (limit "
     << limits.max_speed / k << ")\n";
-  t << "  max commanded acc : " << s.max_commanded_accel / k << " " << unit
+  t << "  max reference acc : " << s.max_commanded_accel / k << " " << unit
     << "/s^2 = " << std::setprecision(0) << 100.0 * s.max_commanded_accel_fraction
     << std::setprecision(2) << " % of the " << limits.max_accel / k << " " << unit
-    << "/s^2 limit\n";
+    << "/s^2 limit (planned)\n";
   t << "  max pseudo-control: " << s.max_pseudo_control / k << " " << unit
-    << "/s^2 (command plus feedback corrections)\n";
+    << "/s^2 (command plus feedback corrections); horizontal "
+    << s.max_pseudo_control_horizontal / k << ", vertical " << s.max_pseudo_control_vertical / k
+    << " (bounds " << pseudo_control_bound.horizontal / k << ", "
+    << pseudo_control_bound.vertical / k << ")\n";
+  t << "  reference jump    : " << s.max_ref_position_jump / k << " " << unit << ", "
+    << s.max_ref_velocity_jump / k << " " << unit << "/s between samples (largest; position bound "
+    << kMaxReferenceJump / k << " " << unit << ")\n";
   t << "  tracking error    : RMS " << s.tracking_rms / k << " " << unit << ", max "
     << s.tracking_max / k << " " << unit << "\n";
-  if (min_clearance)
-    t << "  least clearance   : " << *min_clearance / k << " " << unit
-      << " to a real obstacle at t = " << *min_clearance_t << " s (required "
-      << limits.clearance / k << ")\n";
+  if (clearance)
+    t << "  least clearance   : " << clearance->distance / k << " " << unit
+      << (clearance->to_ground ? " to the ground" : " to a real obstacle")
+      << " at t = " << clearance->t << " s (required " << limits.clearance / k << ")\n";
   if (last_cuboids)
     t << "  obstacle database : " << last_cuboids->num_cuboids << " cuboids at the end, "
       << scan_points_seen << " LIDAR points mapped\n";

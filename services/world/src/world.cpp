@@ -390,4 +390,8 @@ double World::distance_to_obstacles(const Vec3& p, double t) const {
   return best;
 }
 
+double World::distance_to_ground(const Vec3& p) const {
+  return std::max(-p.z() - ground_altitude_, 0.0);
+}
+
 }  // namespace ofn::world

@@ -1,6 +1,7 @@
 #pragma once
 // Figures of merit of one flight from its navigation and control-status
-// samples. Pure core: plain vectors in, a summary out.
+// samples, and the benchmark verdict on them. Pure core: plain vectors (and
+// the true world, for the clearance) in, a summary and a verdict out.
 
 #include <optional>
 #include <string>
@@ -8,6 +9,7 @@
 
 #include "ofn/common/frames.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/world/world.hpp"
 
 namespace ofn::report {
 
@@ -36,6 +38,9 @@ struct FlightSummary {
   /// m/s, least velocity along the course (north) between the gates; the
   /// limits ask for >= 0. Zero without both gates.
   double min_forward_speed = 0;
+  /// m/s, largest speed over the last kHoverWindow of navigation data;
+  /// none when the data is shorter than that. Tells a hover at the end.
+  std::optional<double> final_max_speed;
   /// m/s^2, largest |acceleration| the trajectory source (waypoint guidance
   /// or the RH optimiser) commanded while the plan was flown: the quantity
   /// the planners' acceleration limit applies to (paper Eq. 8).
@@ -44,29 +49,92 @@ struct FlightSummary {
   /// m/s^2, largest |outer-loop pseudo-control|: the command plus the
   /// controller's feedback corrections.
   double max_pseudo_control = 0;
+  /// m/s^2, largest north-east norm and largest |down| part of the
+  /// pseudo-control: the two parts the controller clamps, each to its bound.
+  double max_pseudo_control_horizontal = 0;
+  double max_pseudo_control_vertical = 0;
+  /// m, largest step of the reference position between consecutive
+  /// CONTROL_STATUS samples beyond what the reference velocity explains
+  /// (trapezoidal), while the plan is flown: a discontinuity in the plan.
+  /// Measured against the reference's own motion, so it does not grow with
+  /// speed or with a sample that went missing.
+  double max_ref_position_jump = 0;
+  std::optional<double> max_ref_position_jump_t;  // s, time of the later sample
+  /// m/s, the same for the reference velocity against its acceleration.
+  double max_ref_velocity_jump = 0;
   double tracking_rms = 0;  // m, |reference - actual| while flying the plan
   double tracking_max = 0;  // m
 };
 
-/// The benchmark rule (../shared/BENCHMARKS.md, "What a run reports"): a
-/// run fails if it misses the finish gate, comes closer than 0.8 R_s to a
-/// real surface, or leaves a limit by more than 2 %.
+/// What the controller clamps its outer-loop pseudo-control to (controller
+/// config outer_loop.max_horizontal_accel and max_vertical_accel). The
+/// published command must stay inside; beyond it the clamp did not hold.
+struct PseudoControlBound {
+  double horizontal = 0;  // m/s^2, norm of the north-east part
+  double vertical = 0;    // m/s^2, |down part|
+};
+
+/// The three ways a run ends (../shared/BENCHMARKS.md, "What a run
+/// reports").
+enum class Outcome {
+  kSuccess,   // goal reached (finish gate crossed), no rule broken
+  kSafeStop,  // goal not reached, no rule broken, hovering at the end
+  kFailure,   // a rule broken, or neither of the above
+};
+/// "success", "safe_stop", "failure": the words of the reports.
+const char* to_string(Outcome outcome);
+
+/// The benchmark rule applied to one flight. `failures` holds one line per
+/// broken rule (and the missed goal, unless the run is a safe stop); it is
+/// empty unless the outcome is kFailure.
 struct Verdict {
-  bool success = false;
-  std::vector<std::string> failures;  // one line per broken rule, empty on success
+  Outcome outcome = Outcome::kFailure;
+  bool success = false;  // outcome == Outcome::kSuccess
+  std::vector<std::string> failures;
 };
 constexpr double kLimitTolerance = 0.02;     // share by which a limit may be exceeded
 constexpr double kClearanceFailShare = 0.8;  // of R_s
+/// m between consecutive CONTROL_STATUS samples (50 Hz): a larger jump of
+/// the reference position is a discontinuity the vehicle cannot follow.
+constexpr double kMaxReferenceJump = 1.0;
+/// A run ends at a hover when its speed stayed below kHoverSpeed over the
+/// last kHoverWindow of the flight.
+constexpr double kHoverSpeed = 0.3;   // m/s
+constexpr double kHoverWindow = 2.0;  // s
 
-/// `min_clearance` is the least true clearance (none: no obstacles);
-/// `has_finish_gate` false judges a flight without gates by its limits and
-/// clearance alone.
+/// How lengths appear in the failure lines (the scenario's display unit).
+struct DisplayUnit {
+  std::string name = "m";
+  double metres_per_unit = 1.0;
+};
+
+/// `min_clearance` is the least true clearance to the obstacles and the
+/// ground (none: no world known); `has_finish_gate` false makes the last
+/// waypoint (controller DONE) the goal instead of the finish gate.
 Verdict judge_flight(const FlightSummary& s, const Limits& limits,
-                     std::optional<double> min_clearance, bool has_finish_gate);
+                     const PseudoControlBound& pseudo_control_bound,
+                     std::optional<double> min_clearance, bool has_finish_gate,
+                     const DisplayUnit& unit = {});
+
+/// Least true clearance of a flight: from each navigation sample to the
+/// nearest real surface, the obstacles present at that time and the ground.
+struct Clearance {
+  double distance = 0;     // m
+  double t = 0;            // s, when it was least
+  bool to_ground = false;  // the nearest surface then was the ground
+};
+/// None without navigation samples.
+std::optional<Clearance> least_clearance(const std::vector<NavSample>& nav,
+                                         const world::World& truth);
 
 /// Time at which the north coordinate first reaches `x` (linear
 /// interpolation between samples), or nullopt.
 std::optional<double> crossing_time(const std::vector<NavSample>& nav, double x);
+
+/// True for the controller modes in which it flies a plan (waypoint
+/// guidance, a REF_TRAJ, and any mode added later to fly one): every mode
+/// but holding before a mission, lost navigation and holding after arrival.
+bool flies_a_plan(int mode);
 
 FlightSummary analyse_flight(const std::vector<NavSample>& nav,
                              const std::vector<StatusSample>& status, const Limits& limits,

@@ -79,6 +79,8 @@ class World {
   /// Distance from p to the nearest obstacle surface (not the ground);
   /// +infinity with no obstacles. 0 inside an obstacle.
   double distance_to_obstacles(const Vec3& p, double t = -1.0) const;
+  /// Height of p above the flat ground; 0 at or below it.
+  double distance_to_ground(const Vec3& p) const;
 
  private:
   std::vector<ObstacleSpec> specs_;
