@@ -172,6 +172,7 @@ TEST(RhPlanner, KeepsAStopAtTheWaypointToItsEndButNotAPlanStillMoving) {
     const double t = first.trajectory.duration() - left;
     StepInput later = input_at(first.trajectory.position(t), t, open);
     later.problem.velocity = first.trajectory.velocity(t);
+    later.problem.acceleration = first.trajectory.acceleration(t);  // as the service starts it
     later.problem.terminal_x = 1000.0;
     return later;
   };

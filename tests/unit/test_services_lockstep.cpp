@@ -148,6 +148,7 @@ class NavFeeder {
   }
   Node& node() { return node_; }
   bool enabled = true;
+  Vec3 velocity = Vec3::Zero();  // reported only; the position stays
 
  private:
   void publish() {
@@ -156,6 +157,7 @@ class NavFeeder {
     m.utime = node_.now();
     m.frame = "NED";
     for (int i = 0; i < 3; ++i) m.position[i] = position_[i];
+    for (int i = 0; i < 3; ++i) m.velocity[i] = velocity[i];
     m.quaternion[0] = 1.0;
     node_.publish(channels::kNavState, m);
   }
@@ -293,6 +295,9 @@ TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
   TrajectoryFeeder feeder(lockstep, uplink::mission_from_scenario(open, 1), here);
   feeder.from = 1.0;
   feeder.velocity = Vec3(0, 3, 0);
+  // The vehicle moves as each trajectory starts, so the controller takes
+  // them (a plan starting off both the reference and the vehicle is a jump).
+  nav.velocity = feeder.velocity;
   auto config = default_controller_config();
   ASSERT_NEAR(rad2deg(config.heading.max_rate), 30.0, 1e-9);
   control::ControllerService controller(lockstep.lcm(), lockstep.clock(), config);
@@ -301,6 +306,7 @@ TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
     lockstep.add(*n);
   lockstep.run(to_utime(6.0));
   feeder.velocity = Vec3(-0.5, -0.2, 0);  // slow, pointing elsewhere
+  nav.velocity = feeder.velocity;
   lockstep.run(to_utime(9.0));
 
   const auto yaw_at = [&](double t) {

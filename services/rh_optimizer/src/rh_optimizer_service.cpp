@@ -327,7 +327,6 @@ void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& 
                                    const std::string& why) {
   publish_nominal(now, position, velocity);
   restart_planning();
-  last_trajectory_ = BsplineTrajectory();
   node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
                    why);
 }
@@ -355,6 +354,7 @@ void RhOptimizerService::publish_nominal(Utime now, const Vec3& position, const 
 
 void RhOptimizerService::restart_planning() {
   planner_.reset();
+  last_trajectory_ = BsplineTrajectory();
   stopping_at_target_ = false;
   stalled_ = false;
 }
@@ -493,10 +493,13 @@ void RhOptimizerService::tick() {
   if (config_.occlusion_depth > 0)
     in.seen = [this](double north, double east) { return visibility_.seen(north, east); };
 
-  const bool had_trajectory = planner_.has_previous();
   const StepOutput out = planner_.step(in);
   ++steps_;
-  if (out.mode == StepMode::kBraking && !had_trajectory) {
+  // Deferring leaves the vehicle to nominal guidance: only before this
+  // engagement has published anything. Once a plan or a stop has been
+  // flown, the controller holds to it (and to its stop) and a silence
+  // would only leave it hovering.
+  if (out.mode == StepMode::kBraking && last_trajectory_.empty()) {
     const double brake = config_.fallback.braking_accel_fraction * limits.max_accel;
     const double braking_distance = velocity.squaredNorm() / (2.0 * std::max(brake, 1e-6));
     if (nominal.conflict_distance > braking_distance + config_.defer_margin) {

@@ -111,8 +111,8 @@ class RhOptimizerService {
   bool refresh_field(Utime now, const Vec3& vehicle);
   void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
   void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
-  /// Forgets the planner's previous plan and the engagement's stop and
-  /// stall flags (a new mission, a hand-back).
+  /// Forgets the planner's previous plan, the last published one and the
+  /// engagement's stop and stall flags (a new mission, a hand-back).
   void restart_planning();
   void publish_stats(Utime now, int8_t status, const std::string& message,
                      const SolveReport* report);

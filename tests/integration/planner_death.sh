@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# The planner's death is not the vehicle's: on bench3, once the RH optimiser
+# has taken over in front of the wall, it is stopped (SIGSTOP) for 3 s and
+# then killed (kill -9). The controller must fly the last plan's stop and
+# hover rather than waypoint guidance into the wall; the restarted optimiser
+# takes over again. The flight must keep 0.8 R_s from the wall and stay
+# within the speed limit + 2 %.
+source "$(dirname "$0")/common.sh"
+scenario="$REPO/sim/scenarios/bench3.yaml"
+/usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$scenario" \
+  --bin "$BIN" --rtf 2 --log-dir "$WORK/run" --timeout 200 --no-pin > "$WORK/launch.txt" 2>&1 &
+launcher=$!
+# Wait for the optimiser to engage (its log line reaches the launcher's output).
+for _ in $(seq 1 120); do
+  grep -q "avoidance engages" "$WORK/launch.txt" && break
+  sleep 0.5
+done
+grep -q "avoidance engages" "$WORK/launch.txt" || { kill $launcher; fail "avoidance never engaged"; }
+sleep 1
+# Only this launcher's optimiser: tests share the process table.
+pid=$(pgrep -P $launcher -f "$BIN/ofn_rh_optimizer" | head -1) || true
+[[ -n "$pid" ]] || { kill $launcher; fail "no rh_optimizer process"; }
+kill -STOP "$pid"
+echo "stopped the RH optimiser for 3 s"
+sleep 3
+kill -CONT "$pid"
+sleep 1
+kill -KILL "$pid"
+echo "killed the RH optimiser"
+wait $launcher || { tail -40 "$WORK/launch.txt"; fail "launcher exit code $?"; }
+grep -q "flying its stop" "$WORK/launch.txt" || fail "the controller never flew the plan's stop"
+log=$(cat "$WORK/run/latest_log")
+"$BIN/ofn_flight_report" --log "$log" --scenario "$scenario" --out "$WORK/report" \
+  > "$WORK/report.txt" || true
+cat "$WORK/report.txt"
+/usr/bin/python3 - "$WORK/report/summary.json" <<'PY' || fail "a safety rule was broken"
+import json, sys
+s = json.load(open(sys.argv[1]))
+print("least clearance %.2f m (0.8 R_s = %.2f m), max speed %.2f m/s (limit %.2f m/s)" % (
+    s["min_clearance"], 0.8 * s["clearance_required"], s["max_speed"], s["limits"]["max_speed"]))
+print("outcome %s %s" % (s["outcome"], "; ".join(s["failures"])))
+ok = s["min_clearance"] >= 0.8 * s["clearance_required"]
+ok = ok and s["max_speed"] <= 1.02 * s["limits"]["max_speed"]
+ok = ok and s["outcome"] in ("success", "safe_stop")
+sys.exit(0 if ok else 1)
+PY
+pass "the optimiser stopped and killed mid-avoidance: the vehicle flew the stop and kept clear"
