@@ -73,5 +73,17 @@ TEST(ReferenceSelector, AStalePlanIsFollowedByItsStopAndAHover) {
   EXPECT_FALSE(selector.avoiding());
 }
 
+TEST(ReferenceSelector, TheHoldBeforeAMissionBrakesFromTheVehiclesState) {
+  ReferenceSelector selector;
+  // Held in trimmed cruise at 3 m/s until the controller engages: the
+  // reference starts on the vehicle, decelerates at 0.4 m/s^2 and hovers.
+  const Reference first = selector.hold(1.0, Vec3(0, 0, -30), Vec3(3, 0, 0), true);
+  EXPECT_LT((first.velocity - Vec3(3, 0, 0)).norm(), 1e-12);
+  EXPECT_NEAR(first.acceleration.norm(), 0.4, 1e-12);
+  const Reference later = selector.hold(20.0, Vec3(99, 0, 0), Vec3::Zero(), false);
+  EXPECT_NEAR(later.position.x(), 0.5 * 3.0 * 3.0 / 0.4, 1e-9);
+  EXPECT_LT(later.velocity.norm(), 1e-12);
+}
+
 }  // namespace
 }  // namespace ofn::control

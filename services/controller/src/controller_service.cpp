@@ -41,6 +41,8 @@ ControllerConfig load_controller_config(YamlReader& r) {
       selector.number_in("resync_velocity", c.selector.resync_velocity, 0.01, 100.0);
   c.selector.stop_accel_fraction =
       selector.number_in("stop_accel_fraction", c.selector.stop_accel_fraction, 0.05, 1.0);
+  c.selector.hold_deceleration =
+      selector.number_in("hold_deceleration", c.selector.hold_deceleration, 0.01, 20.0);
   selector.finish();
   YamlReader outer = r.child("outer_loop");
   c.gains.position = read_vec3(outer, "position_gain", c.gains.position);
@@ -285,9 +287,9 @@ void ControllerService::control_step() {
   // The horizontal direction to face, if there is one.
   std::optional<Vec3> facing;
   if (!guidance_.has_mission()) {
-    if (previous != control_status_t::HOLD) hold_position_ = x.position;
+    ref =
+        selector_.hold(to_seconds(now), x.position, x.velocity, previous != control_status_t::HOLD);
     mode_ = control_status_t::HOLD;
-    ref.position = hold_position_;
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;

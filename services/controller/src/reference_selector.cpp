@@ -39,11 +39,26 @@ Reference ReferenceSelector::safe_stop(double now, const Reference& flown, doubl
     stop_ = stop_from(flown.position, flown.velocity, settings_.stop_accel_fraction * max_accel);
     stop_start_ = now;
   }
-  const double t = now - stop_start_;
-  Reference r = flown;
-  r.position = stop_->position(t);
-  r.velocity = stop_->velocity_at(t);
-  r.acceleration = stop_->acceleration_at(t);
+  Reference r = along(*stop_, now - stop_start_);
+  r.yaw = flown.yaw;
+  r.yaw_rate = flown.yaw_rate;
+  return r;
+}
+
+Reference ReferenceSelector::hold(double now, const Vec3& position, const Vec3& velocity,
+                                  bool begins) {
+  if (begins) {
+    hold_ = stop_from(position, velocity, settings_.hold_deceleration);
+    hold_start_ = now;
+  }
+  return along(hold_, now - hold_start_);
+}
+
+Reference ReferenceSelector::along(const StopProfile& stop, double t) {
+  Reference r;
+  r.position = stop.position(t);
+  r.velocity = stop.velocity_at(t);
+  r.acceleration = stop.acceleration_at(t);
   return r;
 }
 

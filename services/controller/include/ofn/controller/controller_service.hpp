@@ -69,7 +69,6 @@ class ControllerService {
   bool mission_pending_ = false;
   std::optional<ref_traj_t> ref_traj_;
   int8_t mode_ = control_status_t::NAV_STALE;  // until the first navigation arrives
-  Vec3 hold_position_ = Vec3::Zero();
   PathHeadingFilter path_heading_;
   int active_waypoint_ = -1;
   Reference last_ref_;

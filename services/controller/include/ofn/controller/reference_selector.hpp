@@ -27,6 +27,10 @@ struct SelectorSettings {
   double resync_position = 1.5;      // m
   double resync_velocity = 1.0;      // m/s
   double stop_accel_fraction = 0.8;  // of the acceleration limit (the optimiser's braking)
+  /// m/s^2 of the hold before any mission (there is no limit yet): a stop
+  /// from the vehicle's state, not a step to zero speed, which commanded
+  /// the pseudo-control's bound at every start from cruise.
+  double hold_deceleration = 0.4;
 };
 
 class ReferenceSelector {
@@ -58,11 +62,19 @@ class ReferenceSelector {
   /// times stop_accel_fraction, then the hover at its end.
   Reference safe_stop(double now, const Reference& flown, double max_accel);
 
+  /// The reference without a mission: the stop from the vehicle's state
+  /// where the hold `begins` at hold_deceleration, then the hover there.
+  Reference hold(double now, const Vec3& position, const Vec3& velocity, bool begins);
+
  private:
+  static Reference along(const StopProfile& stop, double t);
+
   SelectorSettings settings_;
   bool avoiding_ = false;
   std::optional<StopProfile> stop_;
   double stop_start_ = 0;
+  StopProfile hold_;
+  double hold_start_ = 0;
 };
 
 }  // namespace ofn::control
