@@ -51,8 +51,10 @@ SUCCESS_GOAL = 0.99
 DENSE_SUCCESS_GOAL = 0.97
 OUTCOMES = ("success", "safe_stop", "failure")
 # Words of the flight verdict's limit failures (services/tools/src/flight_analysis.cpp
-# judge_flight): speed, vertical speed, commanded acceleration, forward speed.
-ENVELOPE_FAILURE_WORDS = ("over the limit", "over 1.02", "forward speed")
+# judge_flight): speed, vertical speed, commanded (reference) acceleration,
+# forward speed and, where the verdict checks it, the controller's command
+# against the bound the controller states.
+ENVELOPE_FAILURE_WORDS = ("over the limit", "over 1.02", "forward speed", "over the bound")
 QUICK_RUNS = 4
 MAX_FAILURE_FIGURES = 30
 PROGRESS_STEP = 0.05  # share of the runs between progress lines when stderr is not a terminal
@@ -229,8 +231,9 @@ DENSE_DESCRIPTION = (
     "no feasible trajectory for counts as sealed, although its optimiser could miss a route that "
     "exists. A field passes when it ends in success, or in a safe stop where the baseline finds no "
     "route. It fails on a failure outcome, a safe stop although the baseline finds a route, a least "
-    "true clearance below 0.8 R_s (clearance violation) or a speed, vertical speed, forward speed or "
-    "commanded acceleration beyond its limit by more than 2 % (envelope excursion).")
+    "true clearance below 0.8 R_s (clearance violation) or a speed, vertical speed, forward speed, "
+    "commanded acceleration or controller command beyond its limit by more than 2 % (envelope "
+    "excursion).")
 
 
 def write_report(args, runs, ctx):
