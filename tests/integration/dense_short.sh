@@ -65,8 +65,9 @@ for name in names:
         ok = False
         continue
     excursions = monte_carlo.envelope_excursions(s.get("failures") or [])
-    print("%s: %s, least clearance %.1f %s = %.2f R_s, max speed %.2f %s/s, %s" % (
-        name, "goal reached" if s.get("success") else "not successful (%s)" % "; ".join(s.get("failures") or []),
+    outcome = s.get("outcome") or ("success" if s.get("success") else "failure")
+    print("%s: %s%s, least clearance %.1f %s = %.2f R_s, max speed %.2f %s/s, %s" % (
+        name, outcome, "" if not s.get("failures") else " (%s)" % "; ".join(s["failures"]),
         least * k, unit, least / rs, s["max_speed"] * k, unit,
         "limits kept" if not excursions else "limit exceeded: " + "; ".join(excursions)))
     if least < 0.8 * rs:
