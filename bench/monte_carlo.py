@@ -2,14 +2,21 @@
 """Monte Carlo over seeded random obstacle fields: success rate, clearance and time ratio.
 
 Usage: monte_carlo.py [--build DIR] [--runs N] [--seed-base S] [--jobs N] [--out DIR]
-                      [--keep-failures] [--keep-all] [--quick]
+                      [--dense] [--keep-failures] [--keep-all] [--quick]
 
-Field i is bench/random_field.py's field of seed S + i (fair by construction;
-the rules are in that file). Each field is flown in the lockstep runner, N at
-a time, and, when the build has ofn_baseline, given its time-optimal baseline.
-Writes OUT/report.md, OUT/results.json (every run), OUT/clearance.png,
-OUT/time_ratio.png, OUT/fields/field-SEED.yaml and, for failed runs, a figure
-OUT/fig-seed-SEED.png.
+Field i is bench/random_field.py's field of seed S + i: a fair one (a route
+always exists) by default, a dense one with --dense (10-25 obstacles, may be
+sealed); the rules of both are in that file. Each field is flown in the
+lockstep runner, N at a time, and, when the build has ofn_baseline, given
+its time-optimal baseline. Writes OUT/report.md, OUT/results.json (every
+run), OUT/clearance.png, OUT/time_ratio.png, OUT/fields/field-SEED.yaml
+(dense-SEED.yaml with --dense) and, for failed runs, a figure
+OUT/failure-figures/fig-seed-SEED.png.
+
+Every flight ends in one outcome (../shared/BENCHMARKS.md): success (finish
+gate crossed, no violation), safe_stop (stopped and hovering because no
+route exists) or failure. A field is passed when it ends in success, or in
+a safe stop where the baseline finds no route either.
 
 Kept on disk: the folder OUT/runs/seed-SEED/ of every failed run (CSVs,
 summary.json, runner output; with --keep-failures also its LCM log, tens of
@@ -18,8 +25,10 @@ hundreds of flight logs would take gigabytes. Every run is deterministic
 given the seed, so any of them can be flown again alone: the report gives
 the command for each failure.
 
-Exit code 1 when the success rate is below 99 % (the goal), 2 for bad
-arguments; the report is written either way.
+Exit code: fair fields, 1 when the success rate is below 99 % (the goal);
+dense fields, 1 when any field fails (a failure outcome, a safe stop
+although the baseline finds a route, a clearance below 0.8 R_s or a limit
+exceeded); 2 for bad arguments. The report is written either way.
 """
 import argparse
 import json
@@ -38,29 +47,41 @@ import campaign_report as cr  # noqa: E402
 import random_field  # noqa: E402
 
 SUCCESS_GOAL = 0.99
+# Dense fields: share of those whose baseline finds a route that must succeed.
+DENSE_SUCCESS_GOAL = 0.97
+OUTCOMES = ("success", "safe_stop", "failure")
+# Words of the flight verdict's limit failures (services/tools/src/flight_analysis.cpp
+# judge_flight): speed, vertical speed, commanded (reference) acceleration,
+# forward speed and, where the verdict checks it, the controller's command
+# against the bound the controller states.
+ENVELOPE_FAILURE_WORDS = ("over the limit", "over 1.02", "forward speed", "over the bound")
 QUICK_RUNS = 4
 MAX_FAILURE_FIGURES = 30
 PROGRESS_STEP = 0.05  # share of the runs between progress lines when stderr is not a terminal
 
 
 class Progress:
-    """Count, successes and ETA on stderr: one redrawn line on a terminal, a
-    line every ~5 % of the runs otherwise (logs, CI)."""
+    """Count, passes, outcomes and ETA on stderr: one redrawn line on a
+    terminal, a line every ~5 % of the runs otherwise (logs, CI)."""
 
     def __init__(self, total, stream=sys.stderr):
         self.total, self.stream = total, stream
         self.tty = stream.isatty()
         self.t0 = time.monotonic()
         self.done = self.ok = 0
+        self.outcomes = dict.fromkeys(OUTCOMES, 0)
         self.next_line = 0
 
-    def update(self, success):
+    def update(self, passed, outcome):
         self.done += 1
-        self.ok += 1 if success else 0
+        self.ok += 1 if passed else 0
+        self.outcomes[outcome] += 1
         elapsed = time.monotonic() - self.t0
         eta = elapsed / self.done * (self.total - self.done)
-        text = "%d/%d fields, %d succeeded, %d failed, %s elapsed, ETA %s" % (
-            self.done, self.total, self.ok, self.done - self.ok, clock(elapsed), clock(eta))
+        text = "%d/%d fields, %d passed, %d failed (%s), %s elapsed, ETA %s" % (
+            self.done, self.total, self.ok, self.done - self.ok,
+            ", ".join("%d %s" % (self.outcomes[o], o.replace("_", " ")) for o in OUTCOMES),
+            clock(elapsed), clock(eta))
         if self.tty:
             width = 30
             filled = int(width * self.done / self.total)
@@ -84,39 +105,97 @@ def rerun_commands(args, seed):
     gen = os.path.join(HERE, "random_field.py")
     tpl = "" if os.path.realpath(args.template) == os.path.realpath(random_field.DEFAULT_TEMPLATE) \
         else " --template " + os.path.abspath(args.template)
-    one = "%s --build %s --config-dir %s%s --seed %d --runs 1 --keep-all --out /tmp/mc-seed-%d" % (
-        me, args.build, args.config_dir, tpl, seed, seed)
-    two = ("%s --seed %d%s --out /tmp/field-%d.yaml && %s --scenario /tmp/field-%d.yaml --config-dir %s "
-           "--out /tmp/field-%d" % (gen, seed, tpl, seed, campaign.bin_path(args.build, "ofn_sim_runner"),
-                                    seed, args.config_dir, seed))
+    dense = " --dense" if args.dense else ""
+    name = field_name(args, seed)
+    one = "%s --build %s --config-dir %s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
+        me, args.build, args.config_dir, tpl, dense, seed, name)
+    two = ("%s%s --seed %d%s --out /tmp/%s.yaml && %s --scenario /tmp/%s.yaml --config-dir %s "
+           "--out /tmp/%s" % (gen, dense, seed, tpl, name, campaign.bin_path(args.build, "ofn_sim_runner"),
+                              name, args.config_dir, name))
     return one, two
+
+
+def field_name(args, seed):
+    return ("dense-%d" if args.dense else "field-%d") % seed
+
+
+def flight_outcome(rec):
+    """'success', 'safe_stop' or 'failure' for one record of campaign.run_lockstep.
+
+    campaign.py is the place for this; while it has no flight_outcome, the
+    runner's summary decides: its 'outcome' when it writes one, otherwise
+    success or failure by campaign.flight_ok (a runner without the outcome
+    has no safe stop to report).
+    """
+    shared = getattr(campaign, "flight_outcome", None)
+    if shared is not None:
+        return shared(rec)
+    s = rec.get("summary") or {}
+    if rec.get("error") is None and s.get("outcome") in OUTCOMES:
+        return s["outcome"]
+    return "success" if campaign.flight_ok(rec) else "failure"
+
+
+def envelope_excursions(failures):
+    """The verdict's failures that are limits exceeded by more than the tolerance."""
+    return [f for f in failures if any(w in f for w in ENVELOPE_FAILURE_WORDS)]
+
+
+def judge_field(r):
+    """Adds the field's verdict to its record r: 'route' (does the baseline
+    find one: True, False, or None when it could not tell), 'clearance_violation',
+    'envelope_excursion', 'passed' and, when not passed, 'why'."""
+    r["route"] = {"ok": True, "infeasible": False}.get(r["baseline_status"])
+    c = r["min_clearance_over_rs"]
+    r["clearance_violation"] = c is not None and c < cr.FAIL_LINE
+    r["envelope_excursion"] = bool(envelope_excursions(r["failures"]))
+    why = []
+    if r["outcome"] == "failure":
+        why.append("failure outcome")
+    elif r["outcome"] == "safe_stop" and r["route"] is not False:
+        why.append("safe stop although %s" % ("the baseline finds a route" if r["route"]
+                                               else "no baseline says the field is sealed"))
+    if r["clearance_violation"]:
+        why.append("clearance below %.1f R_s" % cr.FAIL_LINE)
+    if r["envelope_excursion"]:
+        why.append("limit exceeded")
+    r["passed"] = not why
+    if why:
+        r["why"] = why
+    return r
 
 
 def fly_field(args, seed, template):
     """Generate, fly and (if possible) baseline one field; tidy its folder."""
-    field = os.path.join(args.out, "fields", "field-%d.yaml" % seed)
-    obstacles = random_field.write_field(seed, field, template)
+    field = os.path.join(args.out, "fields", field_name(args, seed) + ".yaml")
+    obstacles = random_field.write_field(seed, field, template, args.dense)
     run_dir = os.path.join(args.out, "runs", "seed-%d" % seed)
     rec = campaign.run_lockstep(args.build, field, run_dir, args.config_dir)
     base = campaign.run_baseline(args.build, field, args.baseline_cache)
     s = rec.get("summary") or {}
     rs = s.get("clearance_required")
+    unit, k = cr.unit_scale(s)
     out = {
         "seed": seed, "field": field, "obstacles": len(obstacles),
         "tall_obstacles": sum(1 for o in obstacles if random_field.is_tall(o)),
-        "success": campaign.flight_ok(rec),
-        "outcome": campaign.flight_outcome(rec),
+        "success": campaign.flight_ok(rec), "outcome": flight_outcome(rec),
         "failures": list(s.get("failures") or []) + ([rec["error"]] if rec.get("error") else []),
         "gate_to_gate_s": s.get("gate_to_gate"),
         "min_clearance_over_rs": s["min_clearance"] / rs if rs and s.get("min_clearance") is not None else None,
+        "min_clearance": s["min_clearance"] * k if s.get("min_clearance") is not None else None,
+        "max_speed": s["max_speed"] * k if s.get("max_speed") is not None else None,
+        "display_unit": unit,
         "baseline_status": base["status"], "baseline_time_s": base.get("baseline_time"),
         "wall_s": rec["wall_s"], "dir": run_dir,
     }
     out["ratio"] = cr.ratio_of(out["gate_to_gate_s"], out["baseline_time_s"])
-    if out["success"] and not args.keep_all:
+    judge_field(out)
+    # A dense field fails on its verdict; a fair one on the flight alone, as always.
+    out["failed"] = not out["passed"] if args.dense else not out["success"]
+    if not out["failed"] and not args.keep_all:
         shutil.rmtree(run_dir, ignore_errors=True)
         out["dir"] = None
-    elif not out["success"]:
+    elif out["failed"]:
         if not args.keep_failures and not args.keep_all:
             log = os.path.join(run_dir, "flight.lcm")
             if os.path.isfile(log):
@@ -138,96 +217,168 @@ def straight_time(template):
     return (float(g["finish_x"]) - float(g["start_x"])) / float(lim["max_speed"])
 
 
+FAIR_DESCRIPTION = (
+    "Each field has 2-5 boxes and cylinders between x = 60 and 360 ft, low ones (top 40-150 ft) "
+    "to climb over and tall ones (250-300 ft) to pass beside, drawn so that a route with R_s "
+    "clearance always exists (the rules are in bench/random_field.py). A run fails if it misses "
+    "the finish gate, comes closer than 0.8 R_s to a real obstacle, or exceeds a limit by more "
+    "than 2 %.")
+DENSE_DESCRIPTION = (
+    "Dense fields: each has 10-25 boxes and cylinders between x = 40 and 380 ft and within 160 ft "
+    "of the course line, tops 40-300 ft (40 % tall, 250-300 ft), surfaces down to 15 ft apart; "
+    "dead ends and gaps too narrow for R_s are kept, so a field may be sealed (the rules are in "
+    "bench/random_field.py). Whether a route exists is what ofn_baseline finds: a field it finds "
+    "no feasible trajectory for counts as sealed, although its optimiser could miss a route that "
+    "exists. A field passes when it ends in success, or in a safe stop where the baseline finds no "
+    "route. It fails on a failure outcome, a safe stop although the baseline finds a route, a least "
+    "true clearance below 0.8 R_s (clearance violation) or a speed, vertical speed, forward speed, "
+    "commanded acceleration or controller command beyond its limit by more than 2 % (envelope "
+    "excursion).")
+
+
 def write_report(args, runs, ctx):
+    """Writes report.md and results.json; returns the results document."""
     n = len(runs)
     ok = sum(1 for r in runs if r["success"])
     lo, hi = cr.wilson_interval(ok, n)
     rate = ok / n if n else 0.0
+    outcomes = {o: sum(1 for r in runs if r["outcome"] == o) for o in OUTCOMES}
     have_baseline = any(r["baseline_status"] != "n/a" for r in runs)
     clear = [r["min_clearance_over_rs"] for r in runs]
     cr.histogram(os.path.join(args.out, "clearance.png"), clear, "least true clearance / R_s",
                  "least clearance to the real obstacles, %d fields" % n,
                  lines=[(cr.FAIL_LINE, "0.8 R_s (fail)", "red"), (1.0, "R_s", "orange")])
     t_ref = straight_time(ctx["template"])
+    # Dense fields: the time ratio means something only for the flights that succeed.
+    timed = [r for r in runs if r["outcome"] == "success"] if args.dense else runs
     if have_baseline:
-        ratios = [r["ratio"] for r in runs]
-        ratio_label, ratio_note = "gate-to-gate time / time-optimal baseline", ""
+        ratios = [r["ratio"] for r in timed]
+        popup_fields = [r["seed"] for r in runs if campaign.timed_obstacles(r["field"])]
+        ratio_label = "gate-to-gate time / time-optimal baseline"
+        ratio_note = "Time ratio: %s; %s." % (
+            campaign.BASELINE_POPUP_NOTE,
+            "none of these fields has a pop-up, so no ratio here is affected" if not popup_fields else
+            "the fields with pop-ups (seeds %s) are affected" % ", ".join(str(v) for v in popup_fields))
     else:
-        ratios = [r["gate_to_gate_s"] / t_ref if r["gate_to_gate_s"] else None for r in runs]
+        ratios = [r["gate_to_gate_s"] / t_ref if r["gate_to_gate_s"] else None for r in timed]
         ratio_label = "gate-to-gate time / unobstructed straight flight (%.1f s)" % t_ref
         ratio_note = ("ofn_baseline is not in the build, so the time-ratio histogram divides by "
                       "the unobstructed straight flight (%.1f s) instead of each field's baseline; "
                       "the baseline columns read n/a." % t_ref)
     cr.histogram(os.path.join(args.out, "time_ratio.png"), ratios, ratio_label,
-                 "time ratio, %d fields" % n,
+                 "time ratio, %d fields" % len(timed),
                  lines=[(campaign.RATIO_LIMIT, "%.3f" % campaign.RATIO_LIMIT, "red"),
                         (campaign.RATIO_GOAL, "%.2f" % campaign.RATIO_GOAL, "orange")] if have_baseline else [])
     finite = [v for v in ratios if v is not None]
+    ratio_basis = "baseline" if have_baseline else "straight flight"
     lines = [
-        "# Monte Carlo: random obstacle fields",
+        "# Monte Carlo: %s random obstacle fields" % ("dense" if args.dense else "fair"),
         "",
         "- date: %s" % ctx["date"],
         "- machine: %d cores, %s" % (ctx["machine"]["cores"], ctx["machine"]["cpu"]),
         "- commit: %s" % ctx["commit"],
         "- binaries: %s/bin, configuration %s" % (args.build, args.config_dir),
-        "- fields: seeds %s (bench/random_field.py, course from %s), %d flown %d at a time"
-        % (seeds_text(args.seeds), os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
+        "- fields: seeds %s (bench/random_field.py%s, course from %s), %d flown %d at a time"
+        % (seeds_text(args.seeds), " --dense" if args.dense else "",
+           os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
         "- wall time: %.0f s in all, %.1f s per field (%.1f s per flight on one core); 1-minute "
         "load average %.1f before, %.1f after" % (ctx["wall_s"], ctx["wall_s"] / max(n, 1),
                                                   sum(r["wall_s"] for r in runs) / max(n, 1),
                                                   ctx["load"][0], ctx["load"][1]),
         "",
-        "Each field has 2-5 boxes and cylinders between x = 60 and 360 ft, low ones (top 40-150 ft) "
-        "to climb over and tall ones (250-300 ft) to pass beside, drawn so that a route with R_s "
-        "clearance always exists (the rules are in bench/random_field.py). A run fails if it misses "
-        "the finish gate, comes closer than 0.8 R_s to a real obstacle, or exceeds a limit by more "
-        "than 2 %.",
+        DENSE_DESCRIPTION if args.dense else FAIR_DESCRIPTION,
         "",
         "## Result",
         "",
         "| | |",
         "|---|---|",
-        "| success rate | **%.1f %%** (%d of %d) |" % (100 * rate, ok, n),
-        "| 95 %% confidence interval (Wilson) | %.1f %% .. %.1f %% |" % (100 * lo, 100 * hi),
-        "| goal | >= %.0f %%: %s |" % (100 * SUCCESS_GOAL, "met" if rate >= SUCCESS_GOAL else "**not met**"),
-        "| least clearance / R_s | min %s, median %s |" % (
-            cr.fmt(min((c for c in clear if c is not None), default=None), 2),
-            cr.fmt(median([c for c in clear if c is not None]), 2)),
-        "| runs inside R_s | %d |" % sum(1 for c in clear if c is not None and c < 1.0),
-        "| time ratio (%s) | median %s, max %s |" % ("baseline" if have_baseline else "straight flight",
-                                                   cr.fmt(median(finite), 3),
-                                                   cr.fmt(max(finite, default=None), 3)),
+        "| outcomes | %s |" % ", ".join("%s %d" % (o.replace("_", " "), outcomes[o]) for o in OUTCOMES),
     ]
+    doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
+           "mode": "dense" if args.dense else "fair", "runs": n, "outcomes": outcomes,
+           "baselines_available": have_baseline, "wall_s": ctx["wall_s"], "load_average": ctx["load"],
+           "seed_base": args.seed_base, "seeds": args.seeds}
+    clear_known = [c for c in clear if c is not None]
+    if args.dense:
+        routed = [r for r in runs if r["route"] is True]
+        routed_ok = sum(1 for r in routed if r["outcome"] == "success")
+        sealed = [r for r in runs if r["route"] is False]
+        unknown = [r for r in runs if r["route"] is None]
+        r_lo, r_hi = cr.wilson_interval(routed_ok, len(routed))
+        r_rate = routed_ok / len(routed) if routed else None
+        violations = sum(1 for r in runs if r["clearance_violation"])
+        excursions = sum(1 for r in runs if r["envelope_excursion"])
+        failed_n = sum(1 for r in runs if r["failed"])
+        goal_met = r_rate is not None and r_rate >= DENSE_SUCCESS_GOAL
+        lines += [
+            "| fields whose baseline finds a route | %d of %d |" % (len(routed), n),
+            "| of those, succeeded | **%s** (%d of %d; 95 %% Wilson interval %.1f %% .. %.1f %%) |"
+            % ("n/a" if r_rate is None else "%.1f %%" % (100 * r_rate), routed_ok, len(routed),
+               100 * r_lo, 100 * r_hi),
+            "| goal | >= %.0f %% of the fields with a route succeed: %s |"
+            % (100 * DENSE_SUCCESS_GOAL, "met" if goal_met else "**not met**"),
+            "| fields the baseline finds sealed | %d; of those, safe stops %d, successes %d |"
+            % (len(sealed), sum(1 for r in sealed if r["outcome"] == "safe_stop"),
+               sum(1 for r in sealed if r["outcome"] == "success")),
+            "| fields without a baseline verdict | %d |" % len(unknown),
+            "| clearance violations (least true clearance < 0.8 R_s) | **%d** |" % violations,
+            "| envelope excursions (a limit exceeded by more than 2 %%) | **%d** |" % excursions,
+            "| least clearance / R_s | min %s, median %s |" % (cr.fmt(min(clear_known, default=None), 2),
+                                                          cr.fmt(median(clear_known), 2)),
+            "| time ratio over the %d successes (%s) | median %s, 95th percentile %s, max %s |" % (
+                len(finite), ratio_basis, cr.fmt(median(finite), 3), cr.fmt(percentile(finite, 0.95), 3),
+                cr.fmt(max(finite, default=None), 3)),
+            "| fields failed | **%d** of %d |" % (failed_n, n),
+        ]
+        doc.update(routed=len(routed), routed_successes=routed_ok, routed_success_rate=r_rate,
+                   routed_wilson95=[r_lo, r_hi], goal=DENSE_SUCCESS_GOAL, goal_met=goal_met,
+                   sealed=len(sealed), no_baseline_verdict=len(unknown),
+                   clearance_violations=violations, envelope_excursions=excursions, failed=failed_n,
+                   ratio_median=median(finite), ratio_p95=percentile(finite, 0.95))
+    else:
+        lines += [
+            "| success rate | **%.1f %%** (%d of %d) |" % (100 * rate, ok, n),
+            "| 95 %% confidence interval (Wilson) | %.1f %% .. %.1f %% |" % (100 * lo, 100 * hi),
+            "| goal | >= %.0f %%: %s |" % (100 * SUCCESS_GOAL, "met" if rate >= SUCCESS_GOAL else "**not met**"),
+            "| least clearance / R_s | min %s, median %s |" % (
+                cr.fmt(min(clear_known, default=None), 2), cr.fmt(median(clear_known), 2)),
+            "| runs inside R_s | %d |" % sum(1 for c in clear_known if c < 1.0),
+            "| time ratio (%s) | median %s, max %s |" % (ratio_basis, cr.fmt(median(finite), 3),
+                                                       cr.fmt(max(finite, default=None), 3)),
+        ]
+        doc.update(successes=ok, success_rate=rate, wilson95=[lo, hi], goal=SUCCESS_GOAL,
+                   goal_met=rate >= SUCCESS_GOAL)
     if ratio_note:
         lines += ["", ratio_note]
     lines += ["", "![least clearance](clearance.png)", "", "![time ratio](time_ratio.png)", "",
               "## Failures", ""]
-    failed = [r for r in runs if not r["success"]]
+    failed = [r for r in runs if r["failed"]]
     if not failed:
         lines.append("None.")
     else:
+        unit = next((r["display_unit"] for r in failed if r.get("display_unit")), "ft")
         lines += ["Folders kept in `runs/` (LCM log %s). Each command flies that field again, alone; "
                   "the lockstep runner is deterministic given the field, up to the RH optimiser's "
                   "wall-time cap per solve, which a busy machine can reach."
                   % ("kept" if args.keep_failures or args.keep_all else "deleted; --keep-failures keeps it"),
-                  "", "| seed | obstacles (tall) | reason | re-run alone |", "|---|---|---|---|"]
+                  "", "| seed | obstacles (tall) | outcome | baseline | least clearance (%s) / R_s "
+                  "| max speed (%s/s) | reason | re-run alone |" % (unit, unit),
+                  "|---|---|---|---|---|---|---|---|"]
         for r in failed:
             one, two = rerun_commands(args, r["seed"])
             fig = " ([figure](failure-figures/%s))" % os.path.basename(r["figure"]) if r.get("figure") else ""
-            lines.append("| %d | %d (%d) | %s%s | `%s` <br> or `%s` |" % (
-                r["seed"], r["obstacles"], r["tall_obstacles"],
-                "; ".join(r["failures"]) or "unknown", fig, one, two))
+            reasons = (r.get("why") or []) + r["failures"] if args.dense else r["failures"]
+            lines.append("| %d | %d (%d) | %s | %s | %s / %s | %s | %s%s | `%s` <br> or `%s` |" % (
+                r["seed"], r["obstacles"], r["tall_obstacles"], r["outcome"].replace("_", " "),
+                {"ok": "route", "infeasible": "sealed"}.get(r["baseline_status"], r["baseline_status"]),
+                cr.fmt(r["min_clearance"]), cr.fmt(r["min_clearance_over_rs"], 2), cr.fmt(r["max_speed"], 2),
+                "; ".join(reasons) or "unknown", fig, one, two))
     with open(os.path.join(args.out, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
-           "runs": n, "successes": ok, "success_rate": rate, "wilson95": [lo, hi],
-           "goal": SUCCESS_GOAL, "goal_met": rate >= SUCCESS_GOAL, "baselines_available": have_baseline,
-           "wall_s": ctx["wall_s"], "load_average": ctx["load"],
-           "seed_base": args.seed_base, "seeds": args.seeds,
-           "results": runs}
+    doc["results"] = runs
     with open(os.path.join(args.out, "results.json"), "w") as f:
         json.dump(doc, f, indent=1)
-    return rate
+    return doc
 
 
 def seeds_text(seeds):
@@ -235,6 +386,17 @@ def seeds_text(seeds):
     if len(seeds) > 1 and seeds == list(range(seeds[0], seeds[-1] + 1)):
         return "%d..%d" % (seeds[0], seeds[-1])
     return ", ".join(str(s) for s in seeds)
+
+
+def percentile(values, q):
+    """The q-quantile (0..1), interpolated linearly between the sorted values; None when empty."""
+    vals = sorted(values)
+    if not vals:
+        return None
+    pos = q * (len(vals) - 1)
+    low = int(math.floor(pos))
+    high = min(low + 1, len(vals) - 1)
+    return vals[low] + (pos - low) * (vals[high] - vals[low])
 
 
 def median(values):
@@ -259,6 +421,9 @@ def parse_args(argv):
                     help="services' config files (default: the repository's)")
     ap.add_argument("--template", default=random_field.DEFAULT_TEMPLATE,
                     help="scenario whose course the fields use (default bench1)")
+    ap.add_argument("--dense", action="store_true",
+                    help="dense fields (10-25 obstacles, 15 ft gaps, may be sealed) instead of fair ones; "
+                    "exit code 1 when any field fails")
     ap.add_argument("--baseline-cache", help="baseline cache folder (default OUT/baselines)")
     ap.add_argument("--keep-failures", action="store_true",
                     help="also keep the LCM logs of failed runs (their CSVs are always kept)")
@@ -308,21 +473,37 @@ def main(argv=None):
     progress = Progress(len(seeds))
     t0 = time.monotonic()
     results = campaign.run_all([(s, (lambda s=s: fly_field(args, s, args.template))) for s in seeds],
-                               args.jobs, lambda s, r, n: progress.update(r["success"]))
+                               args.jobs, lambda s, r, n: progress.update(not r["failed"], r["outcome"]))
     runs = [results[s] for s in seeds]
     ctx = {"date": campaign.now_text(), "machine": campaign.machine_info(), "commit": campaign.git_commit(),
            "template": template, "template_path": os.path.abspath(args.template),
            "wall_s": time.monotonic() - t0, "load": (load_before, os.getloadavg()[0])}
-    rate = write_report(args, runs, ctx)
-    ok = sum(1 for r in runs if r["success"])
-    lo, hi = cr.wilson_interval(ok, len(runs))
-    print("success rate %.1f %% (%d/%d), 95 %% CI %.1f..%.1f %%; %.0f s wall, %.1f s per field"
-          % (100 * rate, ok, len(runs), 100 * lo, 100 * hi, ctx["wall_s"], ctx["wall_s"] / len(runs)))
+    doc = write_report(args, runs, ctx)
+    print("outcomes: %s" % ", ".join("%s %d" % (o, doc["outcomes"][o]) for o in OUTCOMES))
+    if args.dense:
+        print("fields with a route (baseline): %d, of which succeeded %d%s; sealed %d; no baseline verdict %d"
+              % (doc["routed"], doc["routed_successes"],
+                 "" if doc["routed_success_rate"] is None else " (%.1f %%)" % (100 * doc["routed_success_rate"]),
+                 doc["sealed"], doc["no_baseline_verdict"]))
+        print("clearance violations %d, envelope excursions %d, time ratio of the successes: median %s, "
+              "95th percentile %s; %.0f s wall, %.1f s per field"
+              % (doc["clearance_violations"], doc["envelope_excursions"], cr.fmt(doc["ratio_median"], 3),
+                 cr.fmt(doc["ratio_p95"], 3), ctx["wall_s"], ctx["wall_s"] / len(runs)))
+    else:
+        lo, hi = doc["wilson95"]
+        print("success rate %.1f %% (%d/%d), 95 %% CI %.1f..%.1f %%; %.0f s wall, %.1f s per field"
+              % (100 * doc["success_rate"], doc["successes"], len(runs), 100 * lo, 100 * hi, ctx["wall_s"],
+                 ctx["wall_s"] / len(runs)))
     for r in runs:
-        if not r["success"]:
-            print("  failed: seed %d: %s" % (r["seed"], "; ".join(r["failures"])))
+        if r["failed"]:
+            print("  failed: seed %d: %s, least clearance %s R_s (%s %s), max speed %s %s/s: %s" % (
+                r["seed"], r["outcome"], cr.fmt(r["min_clearance_over_rs"], 2), cr.fmt(r["min_clearance"]),
+                r["display_unit"], cr.fmt(r["max_speed"], 2), r["display_unit"],
+                "; ".join((r.get("why") or []) + r["failures"] if args.dense else r["failures"])))
     print("report: %s" % os.path.join(args.out, "report.md"))
-    return 0 if rate >= SUCCESS_GOAL else 1
+    if args.dense:
+        return 1 if doc["failed"] else 0
+    return 0 if doc["success_rate"] >= SUCCESS_GOAL else 1
 
 
 if __name__ == "__main__":

@@ -1,13 +1,17 @@
 #!/usr/bin/python3
 """Seeded random obstacle fields over the benchmark course, written as scenario YAML.
 
-Usage: random_field.py --seed S --out FILE [--template sim/scenarios/bench1.yaml]
+Usage: random_field.py --seed S --out FILE [--dense] [--template sim/scenarios/bench1.yaml]
 
 The course (start, goal waypoint, limits, gates, max_time, units) is copied
 from the template, bench1 by default; only the obstacles are drawn. The same
-seed and template always give the same file, byte for byte.
+seed, class and template always give the same file, byte for byte.
 
-Fairness rules (every field that breaks one is redrawn from the same random
+Two classes of field (../shared/BENCHMARKS.md): "fair" fields (the default),
+in which a route with R_s clearance always exists, and "dense" fields
+(--dense), which may be sealed.
+
+Fair fields. Fairness rules (every field that breaks one is redrawn from the same random
 stream, so the result is still a function of the seed alone). Lengths in ft,
 R_s = limits.clearance of the template (20 ft for bench1):
 
@@ -37,6 +41,28 @@ R_s = limits.clearance of the template (20 ft for bench1):
 
 Obstacles: boxes (footprint sides 20..120, yaw 0..180 deg) and cylinders
 (radius 10..30), as documented in docs/SCENARIO_FORMAT.md.
+
+Dense fields (--dense). No fairness rule: dead ends, sealed corridors and
+gaps narrower than 2 R_s (impassable) are kept, and whether a route exists
+is for the time-optimal baseline to find out. Only these rules hold (an
+obstacle that breaks one is redrawn from the same stream, as above):
+
+  D1. 10 to 25 obstacles, each wholly inside 40 <= x <= 380 and
+      -160 <= y <= 160: the run-up from the start and the run-out to the
+      goal stay clear, so the clock starts and stops in steady flight.
+  D2. No obstacle within R_s + 30 of the start position or the goal
+      waypoint (implied by D1 for bench1's course, checked for any template).
+  D3. Any two obstacles at least 15 ft apart in plan, surface to surface, so
+      that none overlap or touch; gaps of 15..2 R_s cannot be flown through
+      with R_s clearance. The distance is computed conservatively: a
+      cylinder is taken as its circumscribed polygon, never smaller than
+      the cylinder itself.
+
+Dense obstacles are smaller than fair ones so that up to 25 fit: boxes with
+footprint sides 15..80 (yaw 0..180 deg) and cylinders of radius 8..30; 40 %
+of them are tall (top 250..300, to be passed beside) and the rest have a top
+anywhere in 40..250, low ones to climb over mixed with ones whose climb costs
+about as much as a detour.
 """
 import argparse
 import math
@@ -61,6 +87,17 @@ CYLINDER_RADIUS = (10.0, 30.0)
 TALL_SHARE = 0.5
 BOX_SHARE = 0.6
 COUNT = (2, 5)
+# Dense fields (rules D1..D3 above).
+DENSE_X_MIN, DENSE_X_MAX = 40.0, 380.0
+DENSE_Y_MAX = 160.0
+DENSE_COUNT = (10, 25)
+DENSE_MIN_GAP = 15.0  # ft, least plan distance between two obstacle surfaces
+DENSE_TALL_SHARE = 0.4
+DENSE_TALL_TOP = (250.0, 300.0)
+DENSE_OTHER_TOP = (40.0, 250.0)
+DENSE_BOX_SIDE = (15.0, 80.0)
+DENSE_CYLINDER_RADIUS = (8.0, 30.0)
+DENSE_TRIES_PER_OBSTACLE = 200
 CIRCLE_SEGMENTS = 48  # cylinders as polygons for the plan distances; error < 0.3 % of the radius
 MAX_DRAWS = 10000
 
@@ -74,11 +111,16 @@ def load_template(path):
     return tpl
 
 
-def footprint(ob):
-    """Plan outline (x, y) of an obstacle as a convex polygon, counter-clockwise or not."""
+def footprint(ob, circumscribed=False):
+    """Plan outline (x, y) of an obstacle as a convex polygon, counter-clockwise or not.
+
+    A cylinder's polygon is inscribed in its circle (vertices on it), or with
+    `circumscribed` drawn round it (edges touching it): the first may read a
+    distance up to 0.3 % of the radius too long, the second never does.
+    """
     cx, cy = ob["center"]
     if ob["kind"] == "cylinder":
-        r = ob["radius"]
+        r = ob["radius"] / (math.cos(math.pi / CIRCLE_SEGMENTS) if circumscribed else 1.0)
         return [(cx + r * math.cos(a), cy + r * math.sin(a))
                 for a in (2 * math.pi * i / CIRCLE_SEGMENTS for i in range(CIRCLE_SEGMENTS))]
     a, b = ob["size"]
@@ -226,6 +268,83 @@ def generate(seed, tpl):
     raise RuntimeError("seed %d: no fair field in %d draws" % (seed, MAX_DRAWS))
 
 
+def _bounding_radius(ob):
+    if ob["kind"] == "cylinder":
+        return ob["radius"]
+    return 0.5 * math.hypot(*ob["size"])
+
+
+def dense_rule_violations(obstacles, tpl):
+    """Every broken dense-field rule (D1..D3), as text; empty for a dense field."""
+    rs = float(tpl["limits"].get("clearance", 0.0))
+    start = tpl["start"]["position"][:2]
+    goal = tpl["waypoints"][-1]["position"][:2]
+    # Circumscribed outlines: a distance read from them is never longer than the true one.
+    shapes = [footprint(ob, circumscribed=True) for ob in obstacles]
+    out = []
+    if not DENSE_COUNT[0] <= len(obstacles) <= DENSE_COUNT[1]:
+        out.append("%d obstacles" % len(obstacles))
+    for i, (ob, poly) in enumerate(zip(obstacles, shapes)):
+        xs = [x for x, _ in poly]
+        ys = [y for _, y in poly]
+        if min(xs) < DENSE_X_MIN or max(xs) > DENSE_X_MAX or min(ys) < -DENSE_Y_MAX or max(ys) > DENSE_Y_MAX:
+            out.append("obstacle %d outside %g <= x <= %g, |y| <= %g"
+                       % (i + 1, DENSE_X_MIN, DENSE_X_MAX, DENSE_Y_MAX))
+        for name, pt in (("start", start), ("goal", goal)):
+            if point_distance(pt, poly) < rs + END_MARGIN_BEYOND_RS:
+                out.append("obstacle %d within R_s + %g of the %s" % (i + 1, END_MARGIN_BEYOND_RS, name))
+        for j in range(i):
+            other = obstacles[j]
+            centres = math.hypot(ob["center"][0] - other["center"][0], ob["center"][1] - other["center"][1])
+            # Bounding circles far enough apart settle it without the polygons.
+            if centres - _bounding_radius(ob) - _bounding_radius(other) >= DENSE_MIN_GAP:
+                continue
+            d = plan_distance(poly, shapes[j])
+            if d < DENSE_MIN_GAP:
+                out.append("obstacles %d and %d %.1f apart (< %.1f)" % (j + 1, i + 1, d, DENSE_MIN_GAP))
+    return out
+
+
+def _draw_dense_obstacle(rng):
+    tall = rng.random() < DENSE_TALL_SHARE
+    height = rng.uniform(*(DENSE_TALL_TOP if tall else DENSE_OTHER_TOP))
+    if rng.random() < BOX_SHARE:
+        ob = {"kind": "box", "size": [rng.uniform(*DENSE_BOX_SIDE), rng.uniform(*DENSE_BOX_SIDE)],
+              "yaw_deg": rng.uniform(0.0, 180.0)}
+    else:
+        ob = {"kind": "cylinder", "radius": rng.uniform(*DENSE_CYLINDER_RADIUS)}
+    ob["center"] = [rng.uniform(DENSE_X_MIN, DENSE_X_MAX), rng.uniform(-DENSE_Y_MAX, DENSE_Y_MAX)]
+    ob["height"] = height
+    return _rounded(ob)
+
+
+def generate_dense(seed, tpl):
+    """(obstacles, draws): a dense field, a function of the seed and the template only.
+
+    The count is drawn first; obstacles are then placed one by one, each
+    redrawn until it keeps rules D1..D3 with those already placed. A field
+    that cannot be completed that way is started afresh from the same stream.
+    """
+    rng = random.Random(seed)
+    draws = 0
+    while draws < MAX_DRAWS:
+        count = rng.randint(*DENSE_COUNT)
+        obstacles = []
+        for _ in range(count):
+            for _ in range(DENSE_TRIES_PER_OBSTACLE):
+                draws += 1
+                ob = _draw_dense_obstacle(rng)
+                trial = obstacles + [ob]
+                if not [v for v in dense_rule_violations(trial, tpl) if not v.endswith(" obstacles")]:
+                    obstacles = trial
+                    break
+            else:
+                break
+        if len(obstacles) == count and not dense_rule_violations(obstacles, tpl):
+            return obstacles, draws
+    raise RuntimeError("seed %d: no dense field in %d draws" % (seed, MAX_DRAWS))
+
+
 def _num(v):
     return ("%.1f" % v).rstrip("0").rstrip(".") if v != int(v) else "%d" % int(v)
 
@@ -234,15 +353,28 @@ def _vec(v):
     return "[" + ", ".join(_num(float(x)) for x in v) + "]"
 
 
-def field_yaml(seed, obstacles, tpl, template_name):
+def field_yaml(seed, obstacles, tpl, template_name, dense=False):
     """Scenario text in the bench file layout."""
     start, lim, gates = tpl["start"], tpl["limits"], tpl["gates"]
-    lines = [
-        "# Random obstacle field, seed %d (bench/random_field.py; course from %s)." % (seed, template_name),
-        "# Regenerate: bench/random_field.py --seed %d --out FILE" % seed,
-        "name: field-%d" % seed,
-        "description: random field %d, %d obstacles (%d tall)"
-        % (seed, len(obstacles), sum(1 for o in obstacles if is_tall(o))),
+    tall = sum(1 for o in obstacles if is_tall(o))
+    if dense:
+        head = [
+            "# Dense random obstacle field, seed %d (bench/random_field.py --dense; course from %s)."
+            % (seed, template_name),
+            "# Dead ends and gaps too narrow for R_s are allowed: a route need not exist.",
+            "# Regenerate: bench/random_field.py --dense --seed %d --out FILE" % seed,
+            "name: dense-%d" % seed,
+            "description: dense random field %d, %d obstacles (%d tall), may be sealed"
+            % (seed, len(obstacles), tall),
+        ]
+    else:
+        head = [
+            "# Random obstacle field, seed %d (bench/random_field.py; course from %s)." % (seed, template_name),
+            "# Regenerate: bench/random_field.py --seed %d --out FILE" % seed,
+            "name: field-%d" % seed,
+            "description: random field %d, %d obstacles (%d tall)" % (seed, len(obstacles), tall),
+        ]
+    lines = head + [
         "units: %s" % tpl["units"],
         "start:",
         "  position: %s" % _vec(start["position"]),
@@ -281,11 +413,11 @@ def field_yaml(seed, obstacles, tpl, template_name):
     return "\n".join(lines) + "\n"
 
 
-def write_field(seed, path, template=DEFAULT_TEMPLATE):
-    """Write the field of `seed` to `path`; returns its obstacle list."""
+def write_field(seed, path, template=DEFAULT_TEMPLATE, dense=False):
+    """Write the field of `seed` (fair, or dense with `dense`) to `path`; returns its obstacle list."""
     tpl = load_template(template)
-    obstacles, _ = generate(seed, tpl)
-    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO))
+    obstacles, _ = (generate_dense if dense else generate)(seed, tpl)
+    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO), dense)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w") as f:
         f.write(text)
@@ -298,9 +430,11 @@ def main():
     ap.add_argument("--out", required=True, help="scenario file to write")
     ap.add_argument("--template", default=DEFAULT_TEMPLATE,
                     help="scenario whose course (start, waypoints, limits, gates) is used")
+    ap.add_argument("--dense", action="store_true",
+                    help="a dense field (10-25 obstacles, 15 ft gaps, may be sealed) instead of a fair one")
     args = ap.parse_args()
     try:
-        obstacles = write_field(args.seed, args.out, args.template)
+        obstacles = write_field(args.seed, args.out, args.template, args.dense)
     except (OSError, ValueError, RuntimeError) as exc:
         print("random_field: error: %s" % exc, file=sys.stderr)
         return 2
