@@ -119,23 +119,6 @@ def field_name(args, seed):
     return ("dense-%d" if args.dense else "field-%d") % seed
 
 
-def flight_outcome(rec):
-    """'success', 'safe_stop' or 'failure' for one record of campaign.run_lockstep.
-
-    campaign.py is the place for this; while it has no flight_outcome, the
-    runner's summary decides: its 'outcome' when it writes one, otherwise
-    success or failure by campaign.flight_ok (a runner without the outcome
-    has no safe stop to report).
-    """
-    shared = getattr(campaign, "flight_outcome", None)
-    if shared is not None:
-        return shared(rec)
-    s = rec.get("summary") or {}
-    if rec.get("error") is None and s.get("outcome") in OUTCOMES:
-        return s["outcome"]
-    return "success" if campaign.flight_ok(rec) else "failure"
-
-
 def envelope_excursions(failures):
     """The verdict's failures that are limits exceeded by more than the tolerance."""
     return [f for f in failures if any(w in f for w in ENVELOPE_FAILURE_WORDS)]
@@ -178,7 +161,7 @@ def fly_field(args, seed, template):
     out = {
         "seed": seed, "field": field, "obstacles": len(obstacles),
         "tall_obstacles": sum(1 for o in obstacles if random_field.is_tall(o)),
-        "success": campaign.flight_ok(rec), "outcome": flight_outcome(rec),
+        "success": campaign.flight_ok(rec), "outcome": campaign.flight_outcome(rec),
         "failures": list(s.get("failures") or []) + ([rec["error"]] if rec.get("error") else []),
         "gate_to_gate_s": s.get("gate_to_gate"),
         "min_clearance_over_rs": s["min_clearance"] / rs if rs and s.get("min_clearance") is not None else None,
