@@ -143,7 +143,14 @@ CommitCheck CommitGate::check(const BsplineTrajectory& plan, double elapsed,
         out.least_unseen_distance = std::min(out.least_unseen_distance, u);
         // The stop's first point is the plan's, within position_tolerance of
         // the start the bound was measured at.
-        if (!(u > 0) || !(u >= unseen_bound - s.position_tolerance))
+        if (!(u > 0)) {
+          std::ostringstream why;
+          why.precision(4);
+          why << "the stop from t=" << t << " s enters a cell no beam has crossed, at (" << p.x()
+              << ", " << p.y() << ") m";
+          return refuse(why.str());
+        }
+        if (!(u >= unseen_bound - s.position_tolerance))
           return refuse(describe("stop distance to unseen space (m)", u, unseen_bound, t));
       }
     }

@@ -517,9 +517,14 @@ void RhOptimizerService::tick() {
   last_trajectory_t0_ = t0;
   std::string message = to_string(out.mode);
   if (!out.reason.empty()) message += ": " + out.reason;
+  if (out.mode == StepMode::kSolved && out.refused > 0)
+    message += (out.reason.empty() ? ": " : "; ") + std::string("the commit gate refused ") +
+               std::to_string(out.refused) + " plan(s) first (" + out.refusal + ")";
   if (out.mode != StepMode::kSolved)
     node_.log().warn("t={:.2f} s {} ({} solves, worst violation {:.3g})", t, message, out.solves,
                      out.report.max_violation);
+  else if (out.refused > 0)
+    node_.log().info("t={:.2f} s {}", t, message);
   else if (out.stalled != stalled_)
     node_.log().info("t={:.2f} s {}", t, out.stalled ? message : "no longer stalled");
   stalled_ = out.stalled;

@@ -147,7 +147,10 @@ StepOutput RhPlanner::step(const StepInput& input) {
   auto committable = [&](const SolveReport& report) {
     if (!report.feasible || !trajectory_finite(report.trajectory)) return false;
     out.commit = gate_check(report.trajectory, 0.0, input);
-    if (!out.commit.committed) ++out.refused;
+    if (!out.commit.committed) {
+      ++out.refused;
+      out.refusal = out.commit.reason;
+    }
     return out.commit.committed;
   };
 

@@ -62,6 +62,7 @@ struct StepOutput {
   bool stalled = false;          // the warm plan was a stall (plan_stalled) and was retried
   CommitCheck commit;            // the commit gate's check of the plan flown (or the last refused)
   int refused = 0;               // feasible plans the commit gate refused this step
+  std::string refusal;           // why it refused the last of them
 };
 
 class RhPlanner {
