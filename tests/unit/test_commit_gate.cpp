@@ -8,12 +8,13 @@
 #include "ofn/mapper/distance_field.hpp"
 #include "ofn/rh_optimizer/commit_gate.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
+#include "rh_step_inputs.hpp"
 
 namespace ofn::rh {
 namespace {
 
-const Limits kLimits{3.048, 0.4877, 1.524, 0.0, 6.096, 60.96};  // the benchmarks' limits, SI
-constexpr double kAltitude = 30.0;
+const Limits kLimits = testing_support::kBenchmarkLimits;
+constexpr double kAltitude = testing_support::kLegAltitude;
 
 // Straight and level along north at `speed` from north = 0 for `duration` s
 // (a cubic B-spline with equally spaced control points is a straight line
@@ -141,16 +142,7 @@ TEST(CommitGate, UnseenDistanceIsToTheNearestUnseenCell) {
 // The planner: a plan without a safe stop is not committed, and a stop,
 // once flown, is never left for the plan it replaced.
 StepInput input_at(const Vec3& position, double time, ClearanceQuery clearance, SeenQuery seen) {
-  StepInput input;
-  input.time = time;
-  RhProblem& p = input.problem;
-  p.frame = GuidanceFrame::from_leg(Vec3(0, 0, -kAltitude), Vec3(300, 0, -kAltitude));
-  p.position = position;
-  p.velocity = Vec3(kLimits.max_speed, 0, 0);
-  p.target = Vec3(300, 0, -kAltitude);
-  p.terminal_x = position.x() + kLimits.sensor_range;
-  p.limits = kLimits;
-  p.clearance = std::move(clearance);
+  StepInput input = testing_support::step_input_at(position, time, std::move(clearance));
   input.seen = std::move(seen);
   return input;
 }

@@ -9,12 +9,13 @@
 
 #include "ofn/mapper/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
+#include "rh_step_inputs.hpp"
 
 namespace ofn::rh {
 namespace {
 
-const Limits kLimits{3.048, 0.4877, 1.524, 0.0, 6.096, 60.96};  // the benchmarks' limits, SI
-constexpr double kAltitude = 30.0;
+const Limits kLimits = testing_support::kBenchmarkLimits;
+constexpr double kAltitude = testing_support::kLegAltitude;
 
 // A field over north [-20, 180), east [-60, 60) with optional boxes
 // (north_lo, north_hi, east_lo, east_hi, top).
@@ -41,17 +42,7 @@ ClearanceQuery field_with(const std::vector<Box>& boxes) {
 }
 
 StepInput input_at(const Vec3& position, double time, ClearanceQuery clearance) {
-  StepInput input;
-  input.time = time;
-  RhProblem& p = input.problem;
-  p.frame = GuidanceFrame::from_leg(Vec3(0, 0, -kAltitude), Vec3(300, 0, -kAltitude));
-  p.position = position;
-  p.velocity = Vec3(kLimits.max_speed, 0, 0);
-  p.target = Vec3(300, 0, -kAltitude);
-  p.terminal_x = position.x() + kLimits.sensor_range;
-  p.limits = kLimits;
-  p.clearance = std::move(clearance);
-  return input;
+  return testing_support::step_input_at(position, time, std::move(clearance));
 }
 
 // The next step's input: the state `out` planned 0.1 s on, at `time`.
