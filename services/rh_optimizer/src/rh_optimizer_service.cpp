@@ -519,7 +519,7 @@ void RhOptimizerService::tick() {
   if (!out.reason.empty()) message += ": " + out.reason;
   if (out.mode == StepMode::kSolved && out.refused > 0)
     message += (out.reason.empty() ? ": " : "; ") + std::string("the commit gate refused ") +
-               std::to_string(out.refused) + " plan(s) first (" + out.refusal + ")";
+               std::to_string(out.refused) + " other plan(s) (" + out.refusal + ")";
   if (out.mode != StepMode::kSolved)
     node_.log().warn("t={:.2f} s {} ({} solves, worst violation {:.3g})", t, message, out.solves,
                      out.report.max_violation);
