@@ -61,9 +61,8 @@ struct StepOutput {
   std::string reason;            // why a fallback was taken, or what the stall retry did
   bool stalled = false;          // the warm plan was a stall (plan_stalled) and was retried
   CommitCheck commit;            // the commit gate's check of the plan flown (or the last refused)
-  int refused =
-      0;  // feasible plans the commit gate refused this step (a solved step flies another)
-  std::string refusal;  // why it refused the last of them
+  int refused = 0;               // feasible plans the commit gate refused this step
+  std::string refusal;           // why it refused the last of them (another may be flown)
 };
 
 class RhPlanner {
