@@ -28,8 +28,10 @@ struct SelectorSettings {
   double resync_velocity = 1.0;      // m/s
   double stop_accel_fraction = 0.8;  // of the acceleration limit (the optimiser's braking)
   /// m/s^2 of the hold before any mission (there is no limit yet): a stop
-  /// from the vehicle's state, not a step to zero speed, which commanded
-  /// the pseudo-control's bound at every start from cruise.
+  /// from the vehicle's state rather than a step to zero speed. In the
+  /// simulator, which freezes the vehicle in trimmed cruise until the
+  /// controller engages, the command still reaches its bound while the
+  /// stop runs ahead of the frozen vehicle.
   double hold_deceleration = 0.4;
 };
 
