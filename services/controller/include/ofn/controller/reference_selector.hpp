@@ -23,9 +23,12 @@ namespace ofn::control {
 struct SelectorSettings {
   double jump_position = 0.5;  // m a new plan may start off the reference flown now
   double jump_velocity = 0.5;  // m/s
-  /// A plan restarted at the vehicle: within this of the measured state.
-  double resync_position = 1.5;      // m
-  double resync_velocity = 1.0;      // m/s
+  /// A plan restarted at the vehicle: within this of the measured state
+  /// (the optimiser starts it at a NAV_STATE a few ms old). Wider, a plan
+  /// that an optimiser resumed after a stall starts from where its old plan
+  /// has got to, a metre or two ahead of a vehicle that has been braking.
+  double resync_position = 0.75;     // m
+  double resync_velocity = 0.5;      // m/s
   double stop_accel_fraction = 0.8;  // of the acceleration limit (the optimiser's braking)
   /// m/s^2 of the hold before any mission (there is no limit yet): a stop
   /// from the vehicle's state rather than a step to zero speed. In the
