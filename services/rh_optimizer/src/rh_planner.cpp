@@ -9,7 +9,6 @@ namespace {
 
 constexpr double kMinHold = 2.0;           // s a braking trajectory holds the hover
 constexpr double kKeepCheckStep = 0.1;     // s between clearance samples of a kept trajectory
-constexpr double kStoppedSpeed = 1e-3;     // m/s below which the vehicle counts as hovering
 constexpr double kEndsAtRestSpeed = 0.05;  // m/s: a plan ending slower stops in a hover
 
 bool trajectory_finite(const BsplineTrajectory& trajectory) {
@@ -74,22 +73,20 @@ void RhPlanner::reset() {
 }
 
 BsplineTrajectory RhPlanner::braking_trajectory(const RhProblem& problem) const {
-  // The exact constant-deceleration profile: a quadratic B-spline whose first
-  // knot interval is the deceleration (a parabola from the state to the stop
-  // point, which lies at v t_stop / 2) and whose second is the hover.
-  Vec3 position = problem.position.allFinite() ? problem.position : Vec3::Zero();
-  Vec3 velocity = problem.velocity.allFinite() ? problem.velocity : Vec3::Zero();
-  const double decel = braking_decel(problem);
-  const double speed = velocity.norm();
-  const double stop_time = speed > kStoppedSpeed ? speed / decel : 0.0;
-  if (stop_time == 0.0) velocity.setZero();
-  const double hold = std::max(kMinHold, stop_time);
-  const double duration = stop_time + hold;
-  const Vec3 stop = position + 0.5 * velocity * stop_time;
+  // The stop of braking.hpp (the one the commit gate checks and the
+  // controller flies) as a quadratic B-spline: its first knot interval is
+  // the deceleration, a parabola from the state to the stop point, and its
+  // second the hover.
+  const Vec3 position = problem.position.allFinite() ? problem.position : Vec3::Zero();
+  const Vec3 velocity = problem.velocity.allFinite() ? problem.velocity : Vec3::Zero();
+  const StopProfile stop = stop_from(position, velocity, braking_decel(problem));
+  const double hold = std::max(kMinHold, stop.stop_time);
+  const double duration = stop.stop_time + hold;
+  const Vec3 end = stop.stop_point();
   // A hover needs no deceleration piece; any interior knot gives the same
   // constant trajectory.
-  const double knot = stop_time > 0 ? stop_time / duration : 0.5;
-  return BsplineTrajectory(2, {0, 0, 0, knot, 1, 1, 1}, {position, stop, stop, stop}, duration);
+  const double knot = stop.stop_time > 0 ? stop.stop_time / duration : 0.5;
+  return BsplineTrajectory(2, {0, 0, 0, knot, 1, 1, 1}, {position, end, end, end}, duration);
 }
 
 double RhPlanner::braking_decel(const RhProblem& problem) const {
