@@ -1,15 +1,44 @@
 #pragma once
 // Receding-horizon steps for the planner's tests: level flight north at the
-// benchmarks' speed limit along a leg from the origin to 300 m north.
+// benchmarks' speed limit along a leg from the origin to 300 m north, over
+// a field of boxes.
 
+#include <memory>
 #include <utility>
+#include <vector>
 
+#include "ofn/mapper/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 
 namespace ofn::rh::testing_support {
 
 inline const Limits kBenchmarkLimits{3.048, 0.4877, 1.524, 0.0, 6.096, 60.96};  // SI
 constexpr double kLegAltitude = 30.0;                                           // m
+
+/// A box on the ground: north [north_lo, north_hi), east [east_lo, east_hi), m.
+struct Box {
+  int north_lo, north_hi, east_lo, east_hi;
+  float top;  // m above ground
+};
+
+/// The clearance over north [-20, 180), east [-60, 60) with these boxes.
+inline ClearanceQuery field_with(const std::vector<Box>& boxes) {
+  mapping::Heightfield heightfield;
+  heightfield.origin_north = -20;
+  heightfield.origin_east = -60;
+  heightfield.rows = 200;
+  heightfield.cols = 120;
+  heightfield.top.assign(static_cast<size_t>(heightfield.rows) * heightfield.cols, 0.0f);
+  for (const Box& b : boxes)
+    for (int n = b.north_lo; n < b.north_hi; ++n)
+      for (int e = b.east_lo; e < b.east_hi; ++e) {
+        const int r = heightfield.row_of(n + 0.5), c = heightfield.col_of(e + 0.5);
+        if (heightfield.inside(r, c)) heightfield.at(r, c) = b.top;
+      }
+  auto field = std::make_shared<mapping::DistanceField>();
+  field->build(heightfield, 0.0, 80.0);
+  return [field](const Vec3& ned) { return field->query(ned); };
+}
 
 /// A step at `time` from `position` at the speed limit along the leg.
 inline StepInput step_input_at(const Vec3& position, double time, ClearanceQuery clearance) {

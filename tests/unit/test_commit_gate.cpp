@@ -30,20 +30,10 @@ FlownState start_of(const BsplineTrajectory& plan) {
   return FlownState{plan.position(0), plan.velocity(0), plan.acceleration(0)};
 }
 
-// A wall across the course from north `wall_north` on (top 80 m), or none.
-ClearanceQuery wall_at(double wall_north) {
-  mapping::Heightfield heightfield;
-  heightfield.origin_north = -40;
-  heightfield.origin_east = -60;
-  heightfield.rows = 200;
-  heightfield.cols = 120;
-  heightfield.top.assign(static_cast<size_t>(heightfield.rows) * heightfield.cols, 0.0f);
-  for (int r = 0; r < heightfield.rows; ++r)
-    for (int c = 0; c < heightfield.cols; ++c)
-      if (heightfield.origin_north + r >= wall_north) heightfield.at(r, c) = 80.0f;
-  auto field = std::make_shared<mapping::DistanceField>();
-  field->build(heightfield, 0.0, 80.0);
-  return [field](const Vec3& ned) { return field->query(ned); };
+// A wall across the field from north `wall_north` on (top 80 m); none at
+// 180 m or more.
+ClearanceQuery wall_at(int wall_north) {
+  return testing_support::field_with({{wall_north, 180, -60, 60, 80.0f}});
 }
 
 SeenQuery seen_up_to(double north_limit) {
@@ -123,11 +113,11 @@ TEST(CommitGate, AStartInsideTheSafetyRadiusMayNotGoDeeper) {
   // moving towards it is not.
   const BsplineTrajectory hover = straight(0.0);
   const CommitCheck stay =
-      gate.check(hover, 0.0, start_of(hover), kLimits, SafetyMap{wall_at(4.0), {}});
+      gate.check(hover, 0.0, start_of(hover), kLimits, SafetyMap{wall_at(4), {}});
   EXPECT_TRUE(stay.committed) << stay.reason;
   const BsplineTrajectory creep = straight(0.5);
   const CommitCheck deeper =
-      gate.check(creep, 0.0, start_of(creep), kLimits, SafetyMap{wall_at(4.0), {}});
+      gate.check(creep, 0.0, start_of(creep), kLimits, SafetyMap{wall_at(4), {}});
   EXPECT_FALSE(deeper.committed);
 }
 
@@ -179,7 +169,7 @@ TEST(RhPlannerCommit, AfterBrakingAFailureNeverReturnsToTheOldPlan) {
   ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
   ASSERT_TRUE(planner.has_previous());
   const StepOutput braked =
-      planner.step(input_at(Vec3(0.3, 0, -kAltitude), 10.1, wall_at(2.0), seen_up_to(1000)));
+      planner.step(input_at(Vec3(0.3, 0, -kAltitude), 10.1, wall_at(2), seen_up_to(1000)));
   ASSERT_EQ(braked.mode, StepMode::kBraking) << braked.reason;
   EXPECT_FALSE(planner.has_previous());
   // Five seconds on, on the stop, a problem no plan can meet (x_f beyond

@@ -17,29 +17,8 @@ namespace {
 const Limits kLimits = testing_support::kBenchmarkLimits;
 constexpr double kAltitude = testing_support::kLegAltitude;
 
-// A field over north [-20, 180), east [-60, 60) with optional boxes
-// (north_lo, north_hi, east_lo, east_hi, top).
-struct Box {
-  int north_lo, north_hi, east_lo, east_hi;
-  float top;
-};
-ClearanceQuery field_with(const std::vector<Box>& boxes) {
-  mapping::Heightfield heightfield;
-  heightfield.origin_north = -20;
-  heightfield.origin_east = -60;
-  heightfield.rows = 200;
-  heightfield.cols = 120;
-  heightfield.top.assign(static_cast<size_t>(heightfield.rows) * heightfield.cols, 0.0f);
-  for (const Box& b : boxes)
-    for (int n = b.north_lo; n < b.north_hi; ++n)
-      for (int e = b.east_lo; e < b.east_hi; ++e) {
-        const int r = heightfield.row_of(n + 0.5), c = heightfield.col_of(e + 0.5);
-        if (heightfield.inside(r, c)) heightfield.at(r, c) = b.top;
-      }
-  auto field = std::make_shared<mapping::DistanceField>();
-  field->build(heightfield, 0.0, 80.0);
-  return [field](const Vec3& ned) { return field->query(ned); };
-}
+using testing_support::Box;
+using testing_support::field_with;
 
 StepInput input_at(const Vec3& position, double time, ClearanceQuery clearance) {
   return testing_support::step_input_at(position, time, std::move(clearance));
