@@ -399,5 +399,38 @@ TEST(MappingDynamics, RemovedObstacleIsRetired) {
   EXPECT_TRUE(retired_after) << "the removed obstacle is still in the database 11 s later";
 }
 
+// A top is in OBSTACLE_GRID at its height only where a beam went over it.
+// bench1's wall (140 ft) is looked over from the approach: the grid holds it
+// at its top all along it, also where the sweep hit it once from far away.
+// The cul-de-sac's back wall (600 ft) is seen from below only, up to where
+// the scan stops looking (42.5 deg): the grid holds it at the ceiling, not
+// at the height of the highest hit, which a climbing vehicle would reach.
+TEST(MappingTops, ATopNoBeamWentOverStandsAtTheCeiling) {
+  const double tol = 1.0 + 1.5;  // one grid cell plus the safety margin
+  {
+    const Scenario scenario = load_scenario(scenario_path("bench1"));
+    const ObstacleSpec& wall = scenario.obstacles.at(0);
+    double top = 0;
+    fly_and_map(scenario, {{-100, 0, 120}, {120, 0, 120}}, {}, [&](mapping::Mapper& m, double t) {
+      if (t > 14.0) top = std::max(top, grid_top_within(m, wall.north - 10 * kFt,
+                                                         wall.north + 10 * kFt, -200 * kFt,
+                                                         200 * kFt));
+    });
+    EXPECT_GT(top, wall.height - tol);
+    EXPECT_LT(top, wall.height + tol);
+  }
+  {
+    const Scenario scenario = load_scenario(scenario_path("trap_cul_de_sac"));
+    const ObstacleSpec& back = scenario.obstacles.at(2);
+    mapping::MapperConfig config;
+    double top = 0;
+    fly_and_map(scenario, {{-100, 0, 120}, {240, 0, 120}}, {}, [&](mapping::Mapper& m, double t) {
+      if (t > 30.0) top = grid_top_within(m, back.north - 10 * kFt, back.north + 10 * kFt,
+                                          -20 * kFt, 20 * kFt);
+    });
+    EXPECT_GE(top, config.grid.ceiling - 1e-3);
+  }
+}
+
 }  // namespace
 }  // namespace ofn

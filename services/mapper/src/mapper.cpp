@@ -7,8 +7,16 @@
 namespace ofn::mapping {
 namespace {
 
-/// Cells a beam must continue past a cell for it to have passed over it.
-constexpr double kSeenOverContinuation = 3.0;
+/// Cells a beam must continue past a cell for it to have passed over it:
+/// one that runs out of range, well past it (it may have ended just behind
+/// a face plane); one that ends in a hit, past the next cell (range noise
+/// of centimetres cannot put the hit of a beam that met a face a whole cell
+/// behind it, while a beam over a low cell that meets a taller one close
+/// behind still shows the low cell's top: a ragged canopy).
+constexpr double kSeenOverContinuationFree = 3.0;
+constexpr double kSeenOverContinuationHit = 1.0;
+/// Cells whose tops differ by no more than this (m) belong to one surface.
+constexpr float kSameSurface = 0.5f;
 
 }  // namespace
 
@@ -33,12 +41,14 @@ void Mapper::add_scan(const ScanInput& scan) {
   if (config_.use_occupancy)
     occupancy_.insert_scan(scan.sensor_origin, scan.points, scan.free_ray_ends);
   seen_points_.clear();
-  for (const auto& p : scan.points) trace_over_tops(scan.sensor_origin, p, seen_points_);
-  for (const auto& p : scan.free_ray_ends) trace_over_tops(scan.sensor_origin, p, seen_points_);
+  for (const auto& p : scan.points)
+    trace_over_tops(scan.sensor_origin, p, kSeenOverContinuationHit, seen_points_);
+  for (const auto& p : scan.free_ray_ends)
+    trace_over_tops(scan.sensor_origin, p, kSeenOverContinuationFree, seen_points_);
   seen_over_.insert_hits(seen_points_);
 }
 
-void Mapper::trace_over_tops(const Vec3& origin, const Vec3& end,
+void Mapper::trace_over_tops(const Vec3& origin, const Vec3& end, double min_continuation,
                              std::vector<Vec3>& seen_points) const {
   // 2-D walk (Amanatides-Woo) through the cells under the beam. Only cells
   // the beam leaves again count, and only where it stays above the cell's
@@ -65,7 +75,6 @@ void Mapper::trace_over_tops(const Vec3& origin, const Vec3& end,
   // cell) proves nothing, one that continues several cells at that height
   // without a return proves the wall is not there.
   const double length_cells = std::hypot(dn, de);
-  const double min_continuation = kSeenOverContinuation;
   while (true) {
     const double t_exit = std::min(t_r, t_c);
     if ((1.0 - t_exit) * length_cells < min_continuation) break;
@@ -87,6 +96,62 @@ void Mapper::trace_over_tops(const Vec3& origin, const Vec3& end,
       t_c += dt_c;
     }
   }
+}
+
+const Heightfield& Mapper::grid() {
+  // Seen from below, a face shows as high as the scanner looked, and a
+  // vehicle climbing beside it towards that line would meet the rest of it
+  // (a 600 ft wall mapped at the 42.5 deg edge of the scan). So a top is
+  // known only where a beam went over it, or on the same surface: cells
+  // joined to such a cell through neighbours whose tops lie within
+  // kSameSurface of the top the beam went over (a wall's end cells, hit
+  // once at the edge of the sweep and never looked over again). Every
+  // other top may reach the ceiling, and the optimiser, the commit gate and
+  // the shadows treat it so.
+  const Heightfield& raw = grid_.raw();
+  const Heightfield& seen = seen_over_.raw();
+  const size_t cells = raw.top.size();
+  top_known_.assign(cells, 0);
+  frontier_.clear();
+  for (int r = 0; r < raw.rows; ++r)
+    for (int c = 0; c < raw.cols; ++c) {
+      const float top = raw.at(r, c);
+      if (top > 0.0f && seen.at(r, c) >= top - 1e-3f) {
+        top_known_[static_cast<size_t>(r) * raw.cols + c] = 1;
+        frontier_.push_back({r, c, top});
+      }
+    }
+  while (!frontier_.empty()) {
+    const KnownTop cell = frontier_.back();
+    frontier_.pop_back();
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const int r = cell.row + dr, c = cell.col + dc;
+        if (!raw.inside(r, c)) continue;
+        const size_t i = static_cast<size_t>(r) * raw.cols + c;
+        const float top = raw.top[i];
+        if (top_known_[i] || top <= 0.0f || std::abs(top - cell.seen_top) > kSameSurface) continue;
+        top_known_[i] = 1;
+        frontier_.push_back({r, c, cell.seen_top});
+      }
+  }
+  // The unknown tops go up to the ceiling over the cells their hits
+  // inflate (the safety margin); the smoothing ramp beside them stays what
+  // the hits make it, so an unseen top does not widen its obstacle.
+  published_ = grid_.filtered();
+  const auto ceiling = static_cast<float>(config_.grid.ceiling);
+  const double margin = config_.grid.safety_margin;
+  const int reach = static_cast<int>(std::floor(margin / raw.resolution));
+  for (int r = 0; r < raw.rows; ++r)
+    for (int c = 0; c < raw.cols; ++c) {
+      if (raw.at(r, c) <= 0.0f || top_known_[static_cast<size_t>(r) * raw.cols + c]) continue;
+      for (int dr = -reach; dr <= reach; ++dr)
+        for (int dc = -reach; dc <= reach; ++dc)
+          if (published_.inside(r + dr, c + dc) &&
+              std::hypot(dr, dc) * raw.resolution <= margin + 1e-9)
+            published_.at(r + dr, c + dc) = ceiling;
+    }
+  return published_;
 }
 
 bool Mapper::rectangle_top_seen(double min_n, double min_e, double max_n, double max_e,

@@ -61,8 +61,11 @@ class Mapper {
   void update_cuboids(Utime now);
 
   const MapperConfig& config() const { return config_; }
-  /// The smoothed, inflated grid (OBSTACLE_GRID).
-  const Heightfield& grid() { return grid_.filtered(); }
+  /// The smoothed, inflated grid (OBSTACLE_GRID). A cell whose top no beam
+  /// has passed over, on it or on the surface it belongs to, stands at the
+  /// ceiling: the scanner saw its face up to where it stopped looking, not
+  /// where the obstacle ends.
+  const Heightfield& grid();
   const Heightfield& raw_grid() const { return grid_.raw(); }
   const std::vector<ObstacleEntry>& obstacles() const { return database_.entries(); }
   const std::vector<Cuboid>& last_extraction() const { return extracted_; }
@@ -78,12 +81,21 @@ class Mapper {
   void for_each_column_top(double min_probability, Visit visit) const;
   void reconcile_with_occupancy();
   Heightfield confirmed_grid();
-  /// Marks the cells whose top the beam from `origin` to `end` passed over.
-  void trace_over_tops(const Vec3& origin, const Vec3& end, std::vector<Vec3>& seen_points) const;
+  /// Marks the cells whose top the beam from `origin` to `end` passed over
+  /// and went on past by `min_continuation` cells.
+  void trace_over_tops(const Vec3& origin, const Vec3& end, double min_continuation,
+                       std::vector<Vec3>& seen_points) const;
   bool rectangle_top_seen(double min_n, double min_e, double max_n, double max_e, double top) const;
 
   MapperConfig config_;
   ObstacleGrid grid_;
+  Heightfield published_;  // OBSTACLE_GRID: the filtered grid with unseen tops at the ceiling
+  struct KnownTop {
+    int row, col;
+    float seen_top;  // the top a beam went over, where the surface was found
+  };
+  std::vector<uint8_t> top_known_;   // scratch, per raw cell
+  std::vector<KnownTop> frontier_;   // scratch
   ObstacleGrid confirmed_;  // scratch: the grid's confirmed cells, inflated and smoothed
   // Per cell, the highest top a beam has been seen to pass over (same
   // geometry as grid_, moved with it).
