@@ -563,10 +563,23 @@ TEST(RhOptimizer, RequiredClearanceLetsAStartInsideClimbOut) {
   problem.limits = Limits{3.0, 0.5, 1.5, 0.0, 6.0, 60.0};
   const double planned = 6.0 + optimizer.settings().clearance_margin;
   EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 20.0, 0.0), planned);
+  // From the start clearance up as far as the vehicle could get from rest:
+  // after the largest time constant, at half the acceleration limit, then
+  // at the speed limit (each less its margin).
+  const double delay = optimizer.settings().time_constants.maxCoeff();
+  const double accel = 0.5 * (1.0 - optimizer.settings().accel_margin) * 0.5;
+  const double speed = (1.0 - optimizer.settings().speed_margin) * 3.0;
   EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 4.0, 0.0), 4.0);
-  EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 4.0, 0.5), 5.5);
-  EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 4.0, 10.0), planned);
-  EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, -2.0, 1.0), 3.0);
+  EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 4.0, delay), 4.0);
+  EXPECT_NEAR(optimizer.required_clearance(problem, 4.0, delay + 2.0), 4.0 + 0.5 * accel * 4.0,
+              1e-12);
+  EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 4.0, 30.0), planned);
+  EXPECT_NEAR(optimizer.required_clearance(problem, -2.0, delay + 1.0), 0.5 * accel, 1e-12);
+  const double t_full = delay + speed / accel;  // at the speed limit from then on
+  problem.limits.clearance = 100.0;             // not reached by then
+  EXPECT_NEAR(optimizer.required_clearance(problem, 0.0, t_full + 0.1) -
+                  optimizer.required_clearance(problem, 0.0, t_full),
+              speed * 0.1, 1e-9);
 }
 
 TEST(RhOptimizer, GuessesReachTheTerminalX) {

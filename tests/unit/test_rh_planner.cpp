@@ -129,7 +129,9 @@ TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {
   EXPECT_FALSE(out.reason.empty());
 
   // Without the retry only one solve runs.
-  RhPlanner no_retry(RhSettings{}, FallbackSettings{0.5, 2.0, 0.8, false});
+  FallbackSettings no_retries;
+  no_retries.cold_retry = false;
+  RhPlanner no_retry(RhSettings{}, no_retries);
   ASSERT_EQ(no_retry.step(input_at(Vec3(0, 0, -kAltitude), 5.0, open)).mode, StepMode::kSolved);
   EXPECT_EQ(no_retry.step(impossible).solves, 1);
 }
@@ -227,7 +229,11 @@ TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
   // solution passes it, and the previous plan, made before it was seen,
   // comes within R_s of it 16 s on.
   auto fail_against_wall_at = [](double wall_north) {
-    RhPlanner planner;
+    // Without the retry to a nearer x, which finds a plan that stays short
+    // of the wall (RhPlanner.NearerTerminalXWhenNoPlanReachesTheHorizon).
+    FallbackSettings fallback;
+    fallback.short_retry = false;
+    RhPlanner planner(RhSettings{}, fallback);
     const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
     EXPECT_EQ(first.mode, StepMode::kSolved) << first.reason;
     const int north = static_cast<int>(wall_north);
@@ -245,6 +251,29 @@ TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
   const auto near = fail_against_wall_at(30.0).second;
   EXPECT_EQ(near.mode, StepMode::kBraking) << near.reason;
   EXPECT_NE(near.reason.find("previous comes within"), std::string::npos) << near.reason;
+}
+
+// A wall across the whole map pops up 30 m ahead: no plan passes it, and the
+// previous one meets it within the braking window, so it cannot be kept.
+// Before the stop, a plan to a nearer x (here 0.3 of the way to the horizon)
+// is tried: it stays short of the wall, its stops are clear, it is flown.
+TEST(RhPlanner, PlansToANearerXBeforeItStops) {
+  FallbackSettings fallback;
+  fallback.short_retry_fraction = 0.3;
+  RhPlanner planner(RhSettings{}, fallback);
+  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+  ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
+  StepInput input =
+      input_at(first.trajectory.position(0.2), 0.2, field_with({{30, 33, -60, 60, 200.0f}}));
+  input.problem.velocity = first.trajectory.velocity(0.2);
+  const StepOutput out = planner.step(input);
+  ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
+  EXPECT_NE(out.reason.find("nearer x"), std::string::npos) << out.reason;
+  EXPECT_TRUE(out.commit.committed) << out.commit.reason;
+  const double x0 = input.problem.position.x();
+  const double x_end = out.trajectory.position(out.trajectory.duration()).x();
+  EXPECT_NEAR(x_end, x0 + 0.3 * (input.problem.terminal_x - x0), 0.5);
+  EXPECT_LT(x_end, 30.0 - kLimits.clearance);
 }
 
 TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {

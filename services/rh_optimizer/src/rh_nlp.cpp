@@ -47,9 +47,22 @@ PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhP
 double PointConstraintModel::required_clearance(double t, double* derivative) const {
   if (derivative) *derivative = 0;
   if (start_clearance_ >= planned_clearance_) return planned_clearance_;
-  const double climbing = std::max(start_clearance_, 0.0) + max_speed_ * t;
+  // As far as a vehicle could get from rest in t: after the largest
+  // acceleration time constant (the commanded-acceleration limit of Eq. 4
+  // holds the acceleration back for about that long), at half the
+  // acceleration limit up to the speed limit, then at it. A ramp at the
+  // speed limit from t = 0 cannot be met from a hover: a stop that ended a
+  // few centimetres inside R_plan made every plan infeasible, and the
+  // vehicle stayed.
+  const double delay = tau_.maxCoeff();
+  const double accel = 0.5 * max_accel_;
+  const double t_full = accel > 0 ? max_speed_ / accel : 0.0;
+  const double moving = std::max(0.0, t - delay);
+  const double gained =
+      moving < t_full ? 0.5 * accel * moving * moving : max_speed_ * (moving - 0.5 * t_full);
+  const double climbing = std::max(start_clearance_, 0.0) + gained;
   if (climbing >= planned_clearance_) return planned_clearance_;
-  if (derivative) *derivative = max_speed_;
+  if (derivative) *derivative = moving < t_full ? accel * moving : max_speed_;
   return climbing;
 }
 

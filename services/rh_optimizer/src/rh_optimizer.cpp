@@ -15,12 +15,55 @@ namespace ofn::rh {
 namespace {
 
 constexpr int kGuessSamples = 40;
+// Points of the resampling that names the worst rule of a failed solve.
+constexpr int kReportSamples = 100;
 // NLopt's SLSQP stops on a small relative cost change even while the
 // constraints are still violated by a few thousandths; tight tolerances let
 // the iteration and time limits end a solve instead, and a warm start still
 // converges in about ten evaluations.
 constexpr double kRelativeCostTolerance = 1e-8;
 constexpr double kRelativeStepTolerance = 1e-7;
+
+// Share of the acceleration limit the path guess speeds up and slows down
+// with: well inside it, so that the commanded acceleration (a + tau da/dt)
+// of the fitted spline stays inside too.
+constexpr double kGuessAccelFraction = 0.5;
+
+/// Distance along a path against time: from v0 up to `speed` at `accel`,
+/// on at `speed`, and down to rest at the end when `stop`; a path too short
+/// for that peaks lower. A path started at `speed` with no stop is flown at
+/// constant speed, as before there was a profile.
+class SpeedProfile {
+ public:
+  SpeedProfile(double v0, double speed, double accel, double length, bool stop)
+      : v0_(v0), accel_(std::max(accel, 1e-6)), length_(length), stop_(stop) {
+    peak_ = speed;
+    const double up = (peak_ * peak_ - v0_ * v0_) / (2 * accel_);
+    const double down = stop_ ? peak_ * peak_ / (2 * accel_) : 0.0;
+    if (up + down > length_)
+      peak_ = stop_ ? std::sqrt((2 * accel_ * length_ + v0_ * v0_) / 2)
+                    : std::sqrt(v0_ * v0_ + 2 * accel_ * length_);
+    peak_ = std::max(peak_, v0_);
+    t_up_ = (peak_ - v0_) / accel_;
+    s_up_ = 0.5 * (v0_ + peak_) * t_up_;
+    t_down_ = stop_ ? peak_ / accel_ : 0.0;
+    const double s_down = 0.5 * peak_ * t_down_;
+    t_cruise_ = std::max(0.0, length_ - s_up_ - s_down) / std::max(peak_, 1e-6);
+  }
+  double duration() const { return t_up_ + t_cruise_ + t_down_; }
+  double distance(double t) const {
+    if (t <= t_up_) return std::min(length_, v0_ * t + 0.5 * accel_ * t * t);
+    t -= t_up_;
+    if (t <= t_cruise_) return std::min(length_, s_up_ + peak_ * t);
+    t = std::min(t - t_cruise_, t_down_);
+    return std::min(length_, s_up_ + peak_ * t_cruise_ + peak_ * t - 0.5 * accel_ * t * t);
+  }
+
+ private:
+  double v0_, accel_, length_;
+  bool stop_;
+  double peak_ = 0, t_up_ = 0, s_up_ = 0, t_down_ = 0, t_cruise_ = 0;
+};
 
 bool finite(const Vec3& v) {
   return v.allFinite();
@@ -230,9 +273,7 @@ RhOptimizer& RhOptimizer::operator=(const RhOptimizer& other) {
 
 double RhOptimizer::required_clearance(const RhProblem& problem, double start_clearance,
                                        double t) const {
-  const double planned = problem.limits.clearance + settings_.clearance_margin;
-  if (start_clearance >= planned) return planned;
-  return std::min(planned, std::max(start_clearance, 0.0) + problem.limits.max_speed * t);
+  return PointConstraintModel(settings_, problem, start_clearance).required_clearance(t);
 }
 
 SolveReport RhOptimizer::solve(const RhProblem& problem, const InitialGuess& guess) {
@@ -325,6 +366,11 @@ SolveReport RhOptimizer::solve(const RhProblem& problem, const InitialGuess& gue
   if (report.trajectory.empty()) {
     report.feasible = false;
     message << "; no finite trajectory";
+  } else if (!report.feasible) {
+    // Which rule the least violating point breaks most: what a user reading
+    // the log needs to know (the clearance, the terminal x, a limit).
+    message << " (worst: " << check(problem, report.trajectory, kReportSamples).worst_name()
+            << ")";
   }
   return finish(message.str());
 }
@@ -484,12 +530,19 @@ InitialGuess RhOptimizer::guess_from_path(const std::vector<Vec3>& path, const R
   const double length = cumulative.back();
   if (length < 1e-3) return guess_straight(problem);
 
+  // Along the route at `speed`; from a slower vehicle (a hover before an
+  // escape) it speeds up first, and a plan that stops at its target slows
+  // down at the end: a constant pace would ask for a step in velocity there,
+  // which SLSQP may not smooth out within the acceleration limits.
+  const SpeedProfile profile(std::min(problem.velocity.norm(), speed), speed,
+                             kGuessAccelFraction * problem.limits.max_accel, length,
+                             problem.stop_at_target);
   InitialGuess guess;
-  guess.duration = length / speed;
+  guess.duration = profile.duration();
   guess.positions.resize(kGuessSamples);
   size_t segment = 0;
   for (int k = 0; k < kGuessSamples; ++k) {
-    const double at = length * k / (kGuessSamples - 1);
+    const double at = profile.distance(guess.duration * k / (kGuessSamples - 1));
     while (segment + 2 < route.size() && cumulative[segment + 1] < at) ++segment;
     const double span = cumulative[segment + 1] - cumulative[segment];
     const double w = span > 0 ? std::clamp((at - cumulative[segment]) / span, 0.0, 1.0) : 0.0;

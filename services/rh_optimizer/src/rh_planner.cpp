@@ -165,7 +165,8 @@ StepOutput RhPlanner::step(const StepInput& input) {
     out.report = optimizer_.solve(problem, cold_guess());
     out.solves = 2;
     accepted = committable(out.report);
-  } else if (accepted && guess.warm && fallback_.stall_retry &&
+  }
+  if (accepted && guess.warm && fallback_.stall_retry &&
              plan_stalled(out.report.trajectory, problem)) {
     SolveReport cold = optimizer_.solve(problem, cold_guess());
     out.solves = 2;
@@ -191,7 +192,40 @@ StepOutput RhPlanner::step(const StepInput& input) {
 
   std::string failure = "solve failed (" + out.report.message + ")";
   if (out.report.feasible && out.refused > 0) failure = "plan refused (" + out.commit.reason + ")";
-  if (!has_previous()) return brake(failure + "; no previous trajectory");
+  // Once more, to a nearer x. The horizon ends past the farthest obstacle
+  // seen, and what lies between may leave no plan that gets there: behind
+  // the gap between two tall obstacles, the space they hide (taken as
+  // obstacle) and the next obstacle beyond can close the way until the
+  // vehicle is through and sees round them. A plan to a nearer x is enough
+  // now: the commit gate still demands its stops, and the next steps reach
+  // farther. Tried where the alternative is a stop, or a kept plan that
+  // is known to run into something later (it only puts off the stop); a
+  // previous plan clear to its end is the better of the two.
+  auto nearer = [&](const std::string& why) {
+    if (!fallback_.short_retry || problem.stop_at_target) return false;
+    RhProblem closer = problem;
+    const double x0 = problem.frame.to_guidance(problem.position).x();
+    closer.terminal_x = x0 + fallback_.short_retry_fraction * (problem.terminal_x - x0);
+    const InitialGuess near_guess =
+        input.global_path.empty() ? RhOptimizer::guess_straight(closer)
+                                  : RhOptimizer::guess_from_path(input.global_path, closer, cruise);
+    SolveReport near = optimizer_.solve(closer, near_guess);
+    ++out.solves;
+    if (!committable(near)) return false;
+    out.report = std::move(near);
+    out.mode = StepMode::kSolved;
+    out.trajectory = out.report.trajectory;
+    out.start_time = input.time;
+    out.reason = why + "; flying a plan to a nearer x instead";
+    previous_ = out.report.trajectory;
+    previous_start_ = input.time;
+    return true;
+  };
+  auto nearer_or_brake = [&](const std::string& why) {
+    if (nearer(why)) return out;
+    return brake(why);
+  };
+  if (!has_previous()) return nearer_or_brake(failure + "; no previous trajectory");
   const double elapsed = input.time - previous_start_;
   const double remaining = previous_.duration() - elapsed;
   // A kept trajectory must leave time for more solves and for the braking
@@ -203,7 +237,7 @@ StepOutput RhPlanner::step(const StepInput& input) {
     std::ostringstream why;
     why << failure << "; previous has " << std::max(remaining, 0.0) << " s left, needs "
         << fallback_.keep_min_remaining;
-    return brake(why.str());
+    return nearer_or_brake(why.str());
   }
   if (problem.clearance) {
     // Only the part of the kept plan that braking could no longer avoid has
@@ -220,7 +254,7 @@ StepOutput RhPlanner::step(const StepInput& input) {
         std::ostringstream why;
         why << failure << "; previous comes within " << clearance << " m of an obstacle at " << t
             << " s";
-        return brake(why.str());
+        return nearer_or_brake(why.str());
       }
     }
   }
@@ -229,7 +263,24 @@ StepOutput RhPlanner::step(const StepInput& input) {
   const CommitCheck kept = gate_check(previous_, elapsed, input);
   if (!kept.committed) {
     out.commit = kept;
-    return brake(failure + "; previous refused (" + kept.reason + ")");
+    return nearer_or_brake(failure + "; previous refused (" + kept.reason + ")");
+  }
+  if (problem.clearance && fallback_.short_retry) {
+    // Beyond the braking window: is the kept plan clear to its end?
+    const double from = elapsed + std::min(remaining, braking_window(problem));
+    const double rest = previous_.duration() - from;
+    const int samples = std::max(2, static_cast<int>(std::ceil(rest / kKeepCheckStep)));
+    for (int k = 0; k <= samples && rest > 0; ++k) {
+      const double t = from + rest * k / samples;
+      const double clearance = problem.clearance(previous_.position(t)).distance;
+      if (!(clearance >= problem.limits.clearance)) {
+        std::ostringstream why;
+        why << failure << "; previous comes within " << clearance << " m of an obstacle at " << t
+            << " s, beyond the braking window";
+        if (nearer(why.str())) return out;
+        break;
+      }
+    }
   }
   out.commit = kept;
   out.mode = StepMode::kKeptPrevious;

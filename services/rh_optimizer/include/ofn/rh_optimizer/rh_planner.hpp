@@ -3,7 +3,8 @@
 // warm start from the previous solution shifted to now, or from the global
 // path when the route changed or the previous solution failed; when a solve
 // fails, keep the previous trajectory if it is still safe against the
-// current map, otherwise brake to a hover. Pure core, time in seconds of the
+// current map, otherwise try once more to a nearer terminal x, and failing
+// that brake to a hover. Pure core, time in seconds of the
 // caller's clock.
 
 #include <string>
@@ -20,6 +21,8 @@ struct FallbackSettings {
   double braking_accel_fraction = 0.8;  // of limits.max_accel used to brake
   bool cold_retry = true;               // after a failed warm solve, try once from the path
   bool stall_retry = true;  // a stalled warm plan: also solve from the path, fly the cheaper
+  bool short_retry = true;  // before a stop (no plan, none to keep): once more to a nearer x
+  double short_retry_fraction = 0.5;  // of the way from the vehicle to the terminal x
 };
 
 /// A stall: the vehicle is slow (below kStallSpeedFraction of the speed
