@@ -182,6 +182,43 @@ TEST(GlobalPlanner, UnobservedTopIsNeverFlownOver) {
   EXPECT_LT(over.cost, around.cost);
 }
 
+// A U of tall walls open towards the start, the vehicle hovering inside:
+// no route advances all the way (the way out turns back), the search in
+// any direction finds one, out of the opening and round a side wall,
+// collision-free and no longer than a route round the U from outside.
+TEST(GlobalPlanner, TheWayOutOfADeadEndTurnsBack) {
+  const std::vector<ObstacleBox> u = {box(1, 30.0, 93.0, -33.5, -30.5, 180.0, false),
+                                      box(2, 30.0, 93.0, 30.5, 33.5, 180.0, false),
+                                      box(3, 90.0, 93.0, -33.5, 33.5, 180.0, false)};
+  PlanRequest request = course_request(u);
+  request.start = Vec3(75.0, 0.0, -kAltitude);
+  request.start_velocity = Vec3::Zero();
+  GlobalPlannerConfig config;
+  GlobalPlanner planner(config);
+  EXPECT_EQ(planner.plan(request).status, PlanStatus::kNoPath);
+  const PlanResult out = planner.plan_any_direction(request);
+  ASSERT_EQ(out.status, PlanStatus::kOk);
+  ASSERT_GE(out.waypoints.size(), 3u);
+  // It leaves through the opening: a waypoint short of the U.
+  double least_north = kInf;
+  for (const Vec3& w : out.waypoints) least_north = std::min(least_north, w.x());
+  EXPECT_LT(least_north, 30.0);
+  EXPECT_EQ(out.path.front(), request.start);
+  EXPECT_EQ(out.path.back(), request.goal);
+  const double margin = config.clearance - config.collision_tolerance - 1e-6;
+  for (const Vec3& p : out.path)
+    for (const ObstacleBox& o : u)
+      EXPECT_FALSE(strictly_inside(p, o.min_corner - Vec3::Constant(margin),
+                                   o.max_corner + Vec3::Constant(margin)))
+          << p.transpose() << " in box " << o.id;
+  // With a route ahead, the search in any direction is no longer.
+  const PlanRequest open = course_request({box(1, 60.0, 63.0, -20.0, 20.0, 180.0, false)});
+  const PlanResult forward = planner.plan(open), any = planner.plan_any_direction(open);
+  ASSERT_EQ(forward.status, PlanStatus::kOk);
+  ASSERT_EQ(any.status, PlanStatus::kOk);
+  EXPECT_LE(any.cost, forward.cost + 1e-6);
+}
+
 TEST(GlobalPlanner, TwoBoxesAreBothAvoided) {
   const GlobalPlannerConfig config;
   GlobalPlanner planner(config);

@@ -559,6 +559,50 @@ std::vector<int> search(Problem& problem) {
   return sequence;
 }
 
+/// Shortest node sequence 0 -> 1 with segments in any direction: the way
+/// out of a dead end, which turns back along the leg, and which search()
+/// (every segment advancing) cannot find. No Eq. 10 check: the vehicle
+/// starts it from a hover. Best-first with lazy segment tests as search(),
+/// but without pruning by the best offer (a node keeps every candidate
+/// parent until one proves clear), which is simpler and fast enough for a
+/// search run only after the forward one failed.
+std::vector<int> search_any_direction(Problem& problem) {
+  const int n = problem.size();
+  const Vec3 goal = problem.nodes()[1];
+  std::vector<double> g(n, kInf);
+  std::vector<int> parent(n, -1);
+  std::vector<char> closed(n, 0);
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  auto close = [&](int v, double cost, int from) {
+    closed[v] = 1;
+    g[v] = cost;
+    parent[v] = from;
+    for (int w = 1; w < n; ++w) {
+      if (closed[w] || w == v) continue;
+      const double offer = cost + problem.length(v, w);
+      open.push({offer + (goal - problem.nodes()[w]).norm(), offer, w, v, false});
+    }
+  };
+  close(0, 0.0, -1);
+  while (!open.empty()) {
+    const Entry e = open.top();
+    open.pop();
+    if (closed[e.node] || problem.blocked(e.parent, e.node)) continue;
+    if (e.node == 1) {
+      g[1] = e.g;
+      parent[1] = e.parent;
+      closed[1] = 1;
+      break;
+    }
+    close(e.node, e.g, e.parent);
+  }
+  if (!closed[1]) return {};
+  std::vector<int> sequence;
+  for (int v = 1; v >= 0; v = parent[v]) sequence.push_back(v);
+  std::reverse(sequence.begin(), sequence.end());
+  return sequence;
+}
+
 std::vector<Vec3> interpolate(const std::vector<Vec3>& waypoints, double spacing) {
   std::vector<Vec3> path;
   if (waypoints.empty()) return path;
@@ -586,6 +630,14 @@ GlobalPlanner::GlobalPlanner(GlobalPlannerConfig config) : config_(config) {
 }
 
 PlanResult GlobalPlanner::plan(const PlanRequest& request) {
+  return plan_with(request, /*any_direction=*/false);
+}
+
+PlanResult GlobalPlanner::plan_any_direction(const PlanRequest& request) {
+  return plan_with(request, /*any_direction=*/true);
+}
+
+PlanResult GlobalPlanner::plan_with(const PlanRequest& request, bool any_direction) {
   Problem problem(config_, request);
   PlanResult result;
   result.nodes = problem.size();
@@ -600,7 +652,7 @@ PlanResult GlobalPlanner::plan(const PlanRequest& request) {
     result.blocking_obstacle = problem.holder_id(problem.goal_holder());
     return result;
   }
-  const std::vector<int> sequence = search(problem);
+  const std::vector<int> sequence = any_direction ? search_any_direction(problem) : search(problem);
   result.segments_checked = problem.segments_checked();
   if (sequence.empty()) {
     result.status = PlanStatus::kNoPath;

@@ -86,15 +86,17 @@ std::vector<ObstacleBox> boxes_from(const cuboid_list_t& msg) {
 }
 
 global_path_t path_message(const PlanResult& result, Utime utime,
-                           const PlanResult* geometric_route) {
+                           const PlanResult* geometric_route, const PlanResult* backtrack_route) {
   global_path_t m;
   m.utime = utime;
   m.frame = "NED";
   m.status = status_code(result.status);
-  const PlanResult& shown = result.status == PlanStatus::kNoPath && geometric_route &&
-                                    geometric_route->status == PlanStatus::kOk
-                                ? *geometric_route
-                                : result;
+  const bool geometric = result.status == PlanStatus::kNoPath && geometric_route &&
+                         geometric_route->status == PlanStatus::kOk;
+  const bool backtrack = result.status == PlanStatus::kNoPath && !geometric && backtrack_route &&
+                         backtrack_route->status == PlanStatus::kOk;
+  if (backtrack) m.status = global_path_t::BACKTRACK;
+  const PlanResult& shown = geometric ? *geometric_route : backtrack ? *backtrack_route : result;
   m.cost = std::isfinite(shown.cost) ? shown.cost : -1.0;
   m.num_points = static_cast<int32_t>(shown.path.size());
   for (const auto& p : shown.path) m.points.push_back({p.x(), p.y(), p.z()});
@@ -179,8 +181,16 @@ void GlobalPlannerService::replan(const char* why) {
   request.leg_from = leg->from;
   request.obstacles = boxes_from(*cuboids_);
   PlanResult result = planner_->plan(request);
-  std::optional<PlanResult> geometric;
+  std::optional<PlanResult> geometric, backtrack;
   if (result.status == PlanStatus::kNoPath) geometric = geometric_planner_->plan(request);
+  // No way on along the leg: is there one back out (a dead end)?
+  if (result.status == PlanStatus::kNoPath && geometric->status != PlanStatus::kOk)
+    backtrack = planner_->plan_any_direction(request);
+  const bool backtracks = backtrack && backtrack->status == PlanStatus::kOk;
+  if (backtracks && !last_backtracks_)
+    node_.log().warn("only a route that turns back exists ({}): {:.1f} m over {} nodes", why,
+                     backtrack->cost, backtrack->waypoints.size());
+  last_backtracks_ = backtracks;
   ++plans_;
   const bool status_changed = !last_plan_ || last_plan_->status != result.status;
   if (status_changed && result.status != PlanStatus::kOk)
@@ -190,7 +200,8 @@ void GlobalPlannerService::replan(const char* why) {
     node_.log().info("route found ({}): {:.1f} m over {} nodes, {} cuboids", why, result.cost,
                      result.waypoints.size(), request.obstacles.size());
   node_.publish(channels::kGlobalPath,
-                path_message(result, now, geometric ? &*geometric : nullptr));
+                path_message(result, now, geometric ? &*geometric : nullptr,
+                             backtrack ? &*backtrack : nullptr));
   node_.set_state(to_string(result.status));
   last_plan_ = std::move(result);
 }

@@ -91,12 +91,19 @@ class GlobalPlanner {
   /// and counted, never fatal.
   PlanResult plan(const PlanRequest& request);
 
+  /// The same graph searched with segments in any direction and no Eq. 10
+  /// check: the way out of a dead end, for a vehicle that stops first and
+  /// may then turn back along the leg. Run it when plan() finds no path.
+  PlanResult plan_any_direction(const PlanRequest& request);
+
   /// Steps 1-6 alone, every segment evaluated: the graph plan() searches.
   PlanGraph build_graph(const PlanRequest& request) const;
 
   const GlobalPlannerConfig& config() const { return config_; }
 
  private:
+  PlanResult plan_with(const PlanRequest& request, bool any_direction);
+
   GlobalPlannerConfig config_;
 };
 

@@ -44,9 +44,11 @@ GlobalPlannerConfig planner_config_for(const GlobalPlannerServiceConfig& config,
 std::vector<ObstacleBox> boxes_from(const cuboid_list_t& msg);
 
 /// GLOBAL_PATH of a plan; with NO_PATH, `points` carry the geometric route
-/// if one was found (a guess for the optimiser, not a flyable plan).
+/// if one was found (a guess for the optimiser, not a flyable plan), or
+/// else, with BACKTRACK, the route in any direction (out of a dead end).
 global_path_t path_message(const PlanResult& result, Utime utime,
-                           const PlanResult* geometric_route = nullptr);
+                           const PlanResult* geometric_route = nullptr,
+                           const PlanResult* backtrack_route = nullptr);
 
 class GlobalPlannerService {
  public:
@@ -75,6 +77,7 @@ class GlobalPlannerService {
   LegTracker legs_;
   int active_leg_ = -1;
   std::optional<PlanResult> last_plan_;
+  bool last_backtracks_ = false;  // the last plan published was BACKTRACK
   int64_t plans_ = 0;
 };
 
