@@ -42,6 +42,26 @@ TEST(PathHeading, TurnsTheShortWayAcrossPlusMinusPi) {
   EXPECT_NEAR(wrap_angle(heading.yaw() - deg2rad(-170)), 0.0, 1e-9);
 }
 
+// A look-around: always a quarter turn to the right of the heading, so the
+// filtered heading turns one way at its bounded rate, through a full turn
+// in 2 pi / max_rate.
+TEST(PathHeading, ALookAroundTurnsAtTheBoundedRateThroughAFullTurn) {
+  PathHeadingFilter filter;
+  filter.reset(0.3);
+  const double rate = PathHeading{}.max_rate;
+  double turned = 0, last = filter.yaw();
+  const int steps = static_cast<int>(std::ceil(2 * M_PI / rate / kDt));
+  for (int i = 0; i < steps; ++i) {
+    filter.update(look_around_facing(filter.yaw()), kDt);
+    const double step = wrap_angle(filter.yaw() - last);
+    EXPECT_NEAR(step, rate * kDt, 1e-9);
+    turned += step;
+    last = filter.yaw();
+  }
+  EXPECT_GE(turned, 2 * M_PI - 1e-9);
+  EXPECT_NEAR(look_around_facing(0.0).y(), 1.0, 1e-12);  // east of north: to the right
+}
+
 TEST(PathHeading, HoldsWithNothingToFace) {
   PathHeadingFilter heading;
   EXPECT_FALSE(heading.initialised());

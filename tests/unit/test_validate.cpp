@@ -350,6 +350,21 @@ TEST(Validate, LidarScanRejectsBadBeams) {
   EXPECT_EQ(validate(m), "");
 }
 
+TEST(Validate, ModesAndStatusesOutsideTheirConstantsAreRejected) {
+  ref_traj_t m = good_traj();
+  m.mode = ref_traj_t::LOOK_AROUND;
+  EXPECT_EQ(validate(m), "");
+  m.mode = ref_traj_t::LOOK_AROUND + 1;
+  EXPECT_NE(validate(m), "");
+  m.mode = -1;
+  EXPECT_NE(validate(m), "");
+  global_path_t p = good_path();
+  p.status = global_path_t::BACKTRACK;
+  EXPECT_EQ(validate(p), "");
+  p.status = global_path_t::BACKTRACK + 1;
+  EXPECT_NE(validate(p), "");
+}
+
 TEST(Validate, RefTrajRejectsNonIncreasingSampleTimes) {
   ref_traj_t m = good_traj();
   m.sample_time = {0.0, 0.5, 0.5};

@@ -165,7 +165,7 @@ std::string validate(const global_path_t& m) {
   if (auto e = check_count(m.num_points, m.points.size(), MessageLimits::kMaxPathPoints, "points");
       !e.empty())
     return e;
-  if (m.status < global_path_t::OK || m.status > global_path_t::NO_PATH) return "unknown status";
+  if (m.status < global_path_t::OK || m.status > global_path_t::BACKTRACK) return "unknown status";
   for (const auto& p : m.points)
     if (p.size() != 3 || !all_finite(p.begin(), p.end())) return "path point not finite";
   return "";
@@ -178,6 +178,7 @@ std::string validate(const ref_traj_t& m) {
       !e.empty())
     return e;
   if (m.num_samples < 2) return "fewer than two samples";
+  if (m.mode < ref_traj_t::NOMINAL || m.mode > ref_traj_t::LOOK_AROUND) return "unknown mode";
   const size_t n = m.sample_time.size();
   if (m.position.size() != n || m.velocity.size() != n || m.acceleration.size() != n)
     return "sample arrays differ in length";

@@ -293,7 +293,9 @@ void ControllerService::control_step() {
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;
-    facing = facing_along(ref.velocity, config_.heading.min_speed);
+    facing = ref_traj_->mode == ref_traj_t::LOOK_AROUND
+                 ? std::optional<Vec3>(look_around_facing(path_heading_.yaw()))
+                 : facing_along(ref.velocity, config_.heading.min_speed);
   } else if (selector_.avoiding()) {
     // The plan went stale mid-avoidance: its stop, then the hover.
     if (!selector_.stopping())

@@ -24,6 +24,11 @@ std::optional<Vec3> facing_along(const Vec3& direction, double min_horizontal) {
   return std::nullopt;
 }
 
+Vec3 look_around_facing(double yaw) {
+  const double ahead = yaw + 0.5 * kPi;
+  return Vec3(std::cos(ahead), std::sin(ahead), 0.0);
+}
+
 double yaw_sweep_offset(const YawSweep& sweep, double t, double* rate) {
   const double w = 2.0 * kPi * sweep.frequency;
   const double ramp = 1.0 / sweep.frequency;

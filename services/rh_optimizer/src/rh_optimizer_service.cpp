@@ -15,6 +15,9 @@ Vec3 vec3_in(YamlReader& r, const std::string& key, const Vec3& fallback, double
   return Vec3(v[0], v[1], v[2]);
 }
 
+// m beyond the planned clearance an escape leg's end is kept from the map.
+constexpr double kEscapeEndMargin = 0.3;
+
 int8_t stats_status(StepMode mode) {
   switch (mode) {
     case StepMode::kSolved:
@@ -116,10 +119,29 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
       f.number_in("braking_accel_fraction", b.braking_accel_fraction, 0.05, 1.0);
   b.cold_retry = f.boolean("cold_retry", b.cold_retry);
   b.stall_retry = f.boolean("stall_retry", b.stall_retry);
+  b.short_retry = f.boolean("short_retry", b.short_retry);
+  b.short_retry_fraction = f.number_in("short_retry_fraction", b.short_retry_fraction, 0.05, 0.95);
   f.finish();
 
   // The stop's deceleration is fallback.braking_accel_fraction and its
   // ground rule the optimiser's: RhPlanner passes them to the gate.
+  {
+    YamlReader v = r.child("recovery");
+    RecoverySettings& d = c.recovery;
+    d.enabled = v.boolean("enabled", d.enabled);
+    d.stuck_time = v.number_in("stuck_time", d.stuck_time, 0.5, 60.0);
+    d.hover_speed = v.number_in("hover_speed", d.hover_speed, 0.01, 5.0);
+    d.look_timeout = v.number_in("look_timeout", d.look_timeout, 1.0, 300.0);
+    d.route_wait = v.number_in("route_wait", d.route_wait, 0.0, 60.0);
+    d.route_timeout = v.number_in("route_timeout", d.route_timeout, 0.0, 300.0);
+    if (d.route_timeout < d.route_wait) v.fail("route_timeout", "must be >= route_wait");
+    d.capture_radius = v.number_in("capture_radius", d.capture_radius, 0.1, 100.0);
+    d.face_tolerance = v.number_in("face_tolerance", d.face_tolerance, 0.01, 3.14);
+    d.face_hold = v.number_in("face_hold", d.face_hold, 0.0, 30.0);
+    d.max_attempts = static_cast<int>(v.integer("max_attempts", d.max_attempts));
+    if (d.max_attempts < 1 || d.max_attempts > 100) v.fail("max_attempts", "expected 1..100");
+    v.finish();
+  }
   YamlReader g = r.child("commit");
   CommitSettings& k = c.commit;
   k.commit_time = g.number_in("commit_time", k.commit_time, 0.0, 10.0);
@@ -209,7 +231,8 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
       planner_(config_.optimizer, config_.fallback, config_.commit),
       switch_(config_.avoidance),
       visibility_(1.0, config_.visibility_band),
-      field_(config_.field) {
+      field_(config_.field),
+      recovery_(config_.recovery) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
       SubscribeOptions{config_.nav_max_age, 0.5});
@@ -260,6 +283,19 @@ void RhOptimizerService::on_grid(const obstacle_grid_t& m) {
 }
 
 void RhOptimizerService::on_global_path(const global_path_t& m) {
+  // What the planner says decides a dead end's recovery: a route along the
+  // leg (also one only too sharp to fly: NO_PATH with points), one that
+  // turns back, or none.
+  route_kind_utime_ = m.utime;
+  if (m.status == global_path_t::OK || (m.status == global_path_t::NO_PATH && m.points.size() >= 2))
+    route_kind_ = RouteKind::kForward;
+  else if (m.status == global_path_t::BACKTRACK && m.points.size() >= 2)
+    route_kind_ = RouteKind::kBacktrack;
+  else
+    route_kind_ = RouteKind::kNoPath;
+  recovery_route_.clear();
+  if (route_kind_ != RouteKind::kNoPath)
+    for (const auto& p : m.points) recovery_route_.emplace_back(p[0], p[1], p[2]);
   // NO_PATH may still carry the shortest collision-free route (too sharp to
   // fly as it is): a good guess of which way round.
   if ((m.status != global_path_t::OK && m.status != global_path_t::NO_PATH) || m.points.size() < 2)
@@ -354,9 +390,38 @@ void RhOptimizerService::publish_nominal(Utime now, const Vec3& position, const 
 
 void RhOptimizerService::restart_planning() {
   planner_.reset();
+  recovery_.reset();
+  last_step_moving_ = false;
   last_trajectory_ = BsplineTrajectory();
   stopping_at_target_ = false;
   stalled_ = false;
+}
+
+RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
+                                                     const Vec3& position, const Vec3& velocity,
+                                                     bool engaged) {
+  RecoveryInput in;
+  in.time = to_seconds(now);
+  in.position = position;
+  in.velocity = velocity;
+  in.yaw = nav_->euler[2];
+  in.engaged = engaged;
+  in.moving_plan = last_step_moving_;
+  in.route = route_kind_;
+  in.route_time = route_kind_utime_ == INT64_MIN ? -1e300 : to_seconds(route_kind_utime_);
+  in.route_points = &recovery_route_;
+  in.leg = GuidanceFrame::from_leg(leg.from, leg.to);
+  RecoveryDecision decision = recovery_.update(in);
+  if (decision.changed) {
+    node_.log().warn("t={:.2f} s recovery: {}: {}", in.time, to_string(decision.phase),
+                     decision.reason);
+    // Each phase plans afresh: an escape in its own frame, normal planning
+    // from wherever the escape or the look left the vehicle.
+    planner_.reset();
+    route_changed_ = true;
+    last_step_moving_ = false;
+  }
+  return decision;
 }
 
 void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::string& message,
@@ -395,6 +460,7 @@ void RhOptimizerService::tick() {
     // A new leg is a new guidance frame: the previous solution is no guess.
     active_leg_ = active->index;
     planner_.reset();
+    recovery_.reset();
     route_changed_ = true;
   }
   if (!grid_ || now - grid_->utime > to_utime(config_.grid_max_age)) {
@@ -417,6 +483,7 @@ void RhOptimizerService::tick() {
   const double stopping_speed = stopping_at_target_ ? velocity.norm() : 0.0;
   const bool engaged =
       switch_.update(t, conflict, cross_track_distance(leg, position), stopping_speed);
+  const RecoveryDecision recovery = update_recovery(now, leg, position, velocity, engaged);
   if (!engaged) {
     if (was_engaged) {
       hand_back(now, position, velocity, "nominal path clear, back on the leg");
@@ -490,11 +557,55 @@ void RhOptimizerService::tick() {
     in.global_path = route_;
   in.global_path_changed = route_changed_;
   route_changed_ = false;
+
+  if (recovery.phase == RecoveryPhase::kLooking || recovery.phase == RecoveryPhase::kTurning ||
+      recovery.phase == RecoveryPhase::kNoRoute) {
+    // Hover where the stop from the state flown ends; while looking (or
+    // turning to an escape leg), the controller turns the heading.
+    const bool looking = recovery.phase != RecoveryPhase::kNoRoute;
+    const BsplineTrajectory hover = planner_.braking_trajectory(p);
+    const Utime t0 = to_utime(t);
+    node_.publish(channels::kRefTraj,
+                  trajectory_message(hover, t0,
+                                     looking ? ref_traj_t::LOOK_AROUND : ref_traj_t::BRAKING,
+                                     config_.sample_period, now));
+    last_trajectory_ = hover;
+    last_trajectory_t0_ = t0;
+    last_step_moving_ = false;
+    note(std::string("recovery: ") + to_string(recovery.phase));
+    return publish_stats(now, looking ? solver_stats_t::LOOKING_AROUND : solver_stats_t::NO_ROUTE,
+                         std::string("recovery: ") + to_string(recovery.phase), nullptr);
+  }
+  const bool escaping = recovery.phase == RecoveryPhase::kEscaping;
+  if (escaping) {
+    // The leg of the escape: from where it began to where the route turns
+    // forward again, along the route; the forward-speed rule of Eq. 8 is
+    // relaxed (the route may bend back), the commit gate is not.
+    const Vec3 leg_end = clear_of_obstacles(
+        clearance, recovery.escape_point,
+        limits.clearance + config_.optimizer.clearance_margin + kEscapeEndMargin);
+    p.frame = GuidanceFrame::from_leg(recovery.escape_from, leg_end);
+    p.target = leg_end;
+    const double x_escape = p.frame.to_guidance(leg_end).x();
+    p.terminal_x =
+        terminal_x(p.frame, heightfield_, position, limits.sensor_range,
+                   limits.clearance + config_.optimizer.clearance_margin, x_escape, min_horizon);
+    p.stop_at_target = p.terminal_x >= x_escape;
+    p.limits.min_forward_speed = -limits.max_speed;
+    stopping_at_target_ = false;
+    in.global_path = recovery.escape_route;
+  }
   if (config_.occlusion_depth > 0)
     in.seen = [this](double north, double east) { return visibility_.seen(north, east); };
 
   const StepOutput out = planner_.step(in);
   ++steps_;
+  // A plan that moves off, not a stop, a stall or a hover in place: the
+  // recovery counts the vehicle stuck without one.
+  last_step_moving_ =
+      out.mode == StepMode::kSolved && !out.stalled &&
+      (out.trajectory.position(out.trajectory.duration()) - out.trajectory.position(0.0)).norm() >
+          2.0 * config_.recovery.capture_radius;
   // Deferring leaves the vehicle to nominal guidance: only before this
   // engagement has published anything. Once a plan or a stop has been
   // flown, the controller holds to it (and to its stop) and a silence
@@ -515,7 +626,7 @@ void RhOptimizerService::tick() {
                                                        config_.sample_period, now));
   last_trajectory_ = out.trajectory;
   last_trajectory_t0_ = t0;
-  std::string message = to_string(out.mode);
+  std::string message = std::string(escaping ? "escaping: " : "") + to_string(out.mode);
   if (!out.reason.empty()) message += ": " + out.reason;
   if (out.mode == StepMode::kSolved && out.refused > 0)
     message += (out.reason.empty() ? ": " : "; ") + std::string("the commit gate refused ") +

@@ -63,6 +63,11 @@ constexpr double kMinLegHorizontal = 0.2;
 /// reference velocity too slow to point anywhere.
 std::optional<Vec3> facing_along(const Vec3& direction, double min_horizontal);
 
+/// The direction to face for a look-around: a quarter turn to the right of
+/// `yaw`, so that the path heading, always turning toward it, turns at its
+/// full rate for as long as the look lasts.
+Vec3 look_around_facing(double yaw);
+
 /// The sweep's yaw offset `t` seconds after it started: a(t) sin(w t) with
 /// the amplitude a ramping linearly from zero over one period, so that the
 /// commanded yaw and its rate start at zero. `rate` receives its derivative.

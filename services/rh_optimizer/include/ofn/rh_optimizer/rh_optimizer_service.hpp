@@ -22,6 +22,7 @@
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
 #include "ofn/rh_optimizer/avoidance_switch.hpp"
+#include "ofn/rh_optimizer/dead_end_recovery.hpp"
 #include "ofn/rh_optimizer/occlusion.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 #include "ofn/scan_world_t.hpp"
@@ -74,6 +75,7 @@ struct RhOptimizerServiceConfig {
   FallbackSettings fallback;
   CommitSettings commit;  // the safety invariant of every published plan
   SwitchSettings avoidance;
+  RecoverySettings recovery;  // out of dead ends
 };
 
 /// Reads an rh_optimizer config; unknown fields are errors.
@@ -111,6 +113,9 @@ class RhOptimizerService {
   bool refresh_field(Utime now, const Vec3& vehicle);
   void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
   void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
+  /// Feeds the dead-end recovery; logs and acts on a change of its phase.
+  RecoveryDecision update_recovery(Utime now, const Leg& leg, const Vec3& position,
+                                   const Vec3& velocity, bool engaged);
   /// Forgets the planner's previous plan, the last published one and the
   /// engagement's stop and stall flags (a new mission, a hand-back).
   void restart_planning();
@@ -136,6 +141,13 @@ class RhOptimizerService {
   Utime field_built_ = INT64_MIN;
   double field_altitude_ = 0;  // vehicle altitude the field's band is centred on
   std::vector<Vec3> route_;    // global path in use as the cold-start guess
+  // What the global planner said last, and the points of its route (any
+  // kind): the dead-end recovery escapes along them.
+  RouteKind route_kind_ = RouteKind::kNone;
+  Utime route_kind_utime_ = INT64_MIN;
+  std::vector<Vec3> recovery_route_;
+  DeadEndRecovery recovery_;
+  bool last_step_moving_ = false;  // the last step committed a plan that moves off
   Utime route_utime_ = INT64_MIN;
   bool route_changed_ = false;
   BsplineTrajectory last_trajectory_;  // last published, for a(t0)

@@ -1,0 +1,137 @@
+#pragma once
+// Out of a dead end. The paper's optimiser only ever flies forward along the
+// leg (Eq. 8, forward speed >= 0): inside a cul-de-sac, before a wall wider
+// than the map or a gap that has closed, no forward plan with a safe stop
+// exists, the commit gate lets only stops through and the vehicle hovers for
+// ever. This core decides what to do then:
+//  1. stuck: avoidance is engaged, the vehicle hovers and no moving plan
+//     has been committed for `stuck_time`;
+//  2. look around: hover and turn the heading through a full turn, so that
+//     the scanner (which sees only +-20 deg about the heading) maps what is
+//     beside and behind the vehicle, and the global planner re-plans on it;
+//  3. then, with the route the global planner finds:
+//     - one that heads along the leg from the vehicle: normal planning;
+//     - one that turns back (BACKTRACK) or first goes sideways round a
+//       wall: escape along it, with the forward speed rule relaxed, leg by
+//       straight leg (stopping at each corner, and turning to face each leg
+//       before it: the scanner sees only ahead, and the space the leg goes
+//       into counts as obstacle until a beam has crossed it), to the first point from
+//       which the rest of the route heads along the leg, then normal
+//       planning (left to itself, the forward-only optimiser would take the
+//       shorter way straight on, back into the dead end);
+//     - none: hold the hover and say so (no route), and take up a route if
+//       one appears later.
+// Every plan flown in recovery passes the same commit gate as any other.
+// Pure core: world NED, SI, time in seconds of the caller's clock.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ofn/common/frames.hpp"
+#include "ofn/rh_optimizer/rh_optimizer.hpp"
+
+namespace ofn::rh {
+
+struct RecoverySettings {
+  bool enabled = true;
+  double stuck_time = 4.0;       // s hovering without a moving plan before the look-around
+  double hover_speed = 0.3;      // m/s below which the vehicle counts as hovering
+  double look_turn = 6.2832;     // rad of heading the look-around turns through (a full turn)
+  double look_timeout = 40.0;    // s; the look ends then, turned through or not
+  double route_wait = 3.0;       // s after the look for the map and the route to take it in
+  double route_timeout = 10.0;   // s after the look without a newer route: no route
+  double capture_radius = 3.0;   // m from the escape point at which the escape is done
+  double face_tolerance = 0.26;  // rad; an escape leg starts once the heading is this near its direction
+  double face_hold = 1.0;        // s facing the leg before it starts (the scanner clears its shadows)
+  int max_attempts = 3;          // looks in a row with no escape leg done between: then "no route" for good
+};
+
+enum class RecoveryPhase { kIdle, kLooking, kTurning, kEscaping, kNoRoute };
+const char* to_string(RecoveryPhase phase);
+
+/// What the global planner last said, as the optimiser received it: a
+/// route along the leg (also one too sharp to fly at cruise speed), one that
+/// turns back, none, or nothing heard yet.
+enum class RouteKind { kNone, kForward, kBacktrack, kNoPath };
+
+struct RecoveryInput {
+  double time = 0;  // s
+  Vec3 position = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  double yaw = 0;             // rad, the vehicle's heading
+  bool engaged = false;       // avoidance engaged (false: guidance flies the leg)
+  bool moving_plan = false;   // the last step committed a solved plan that moves off
+  RouteKind route = RouteKind::kNone;
+  double route_time = -1e300;            // s, when that route was made
+  // world NED, vehicle first: the route's points, whatever its kind
+  const std::vector<Vec3>* route_points = nullptr;
+  GuidanceFrame leg;                     // the mission leg's frame
+};
+
+struct RecoveryDecision {
+  RecoveryPhase phase = RecoveryPhase::kIdle;
+  bool changed = false;  // the phase changed on this update
+  std::string reason;    // why it changed (empty otherwise)
+  // While escaping: where to, from where (the frame's origin, fixed for the
+  // escape), and the route points up to there (world NED).
+  Vec3 escape_from = Vec3::Zero();
+  Vec3 escape_point = Vec3::Zero();
+  std::vector<Vec3> escape_route;
+};
+
+/// Index of the first route point from which every further step heads
+/// along the leg, within acos(min_cosine) of its direction (60 deg): where
+/// the forward-only optimiser can take over. nullopt for fewer than two
+/// points.
+std::optional<size_t> forward_from(const std::vector<Vec3>& route, const GuidanceFrame& leg,
+                                   double min_cosine = 0.5);
+
+/// Where the next straight leg of an escape along `route` ends: the first
+/// corner (the direction turns by more than `corner_angle`, rad) farther
+/// than `min_length` from the route's start and before forward_from(), or
+/// forward_from() itself. Each leg is flown from rest to rest: a guess
+/// along a straight line is one SLSQP can make feasible, a corner taken at
+/// speed in the guess is not.
+std::optional<size_t> escape_leg_end(const std::vector<Vec3>& route, const GuidanceFrame& leg,
+                                     double min_length = 0.0, double corner_angle = 0.26);
+
+/// `point` moved up the clearance gradient until it is at least `required`
+/// from the mapped obstacles (at most `max_shift` m, horizontally): an
+/// escape leg stops exactly at its end, and a route node sits at R_s from
+/// its cuboid, inside the optimiser's R_s plus margin from the grid.
+Vec3 clear_of_obstacles(const ClearanceQuery& clearance, const Vec3& point, double required,
+                        double max_shift = 3.0);
+
+class DeadEndRecovery {
+ public:
+  explicit DeadEndRecovery(RecoverySettings settings = {}) : settings_(settings) {}
+
+  RecoveryDecision update(const RecoveryInput& in);
+  /// Back to idle with no attempts counted (a new mission or leg).
+  void reset();
+  RecoveryPhase phase() const { return decision_.phase; }
+  int attempts() const { return attempts_; }
+  const RecoverySettings& settings() const { return settings_; }
+
+ private:
+  void enter(RecoveryPhase phase, std::string reason);
+  bool stuck(const RecoveryInput& in);
+  /// Takes up the route of `in` if it leads anywhere: normal planning or
+  /// an escape. Returns false when there is none.
+  bool take_route(const RecoveryInput& in);
+
+  RecoverySettings settings_;
+  RecoveryDecision decision_;
+  std::optional<double> stuck_since_;
+  double turned_ = 0;  // rad of heading turned since the look began
+  double last_yaw_ = 0;
+  double look_start_ = 0;
+  std::optional<double> look_end_;
+  std::optional<double> facing_since_;
+  double face_yaw_ = 0;                           // rad, where kTurning turns to
+  RecoveryPhase after_turn_ = RecoveryPhase::kIdle;  // what follows kTurning
+  int attempts_ = 0;
+};
+
+}  // namespace ofn::rh

@@ -1,0 +1,217 @@
+#include "ofn/rh_optimizer/dead_end_recovery.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace ofn::rh {
+
+const char* to_string(RecoveryPhase phase) {
+  switch (phase) {
+    case RecoveryPhase::kIdle:
+      return "idle";
+    case RecoveryPhase::kLooking:
+      return "looking around";
+    case RecoveryPhase::kTurning:
+      return "turning to the escape leg";
+    case RecoveryPhase::kEscaping:
+      return "escaping";
+    case RecoveryPhase::kNoRoute:
+      return "no route";
+  }
+  return "?";
+}
+
+std::optional<size_t> escape_leg_end(const std::vector<Vec3>& route, const GuidanceFrame& leg,
+                                     double min_length, double corner_angle) {
+  const auto end = forward_from(route, leg);
+  if (!end) return std::nullopt;
+  const double cos_corner = std::cos(corner_angle);
+  for (size_t k = 1; k < *end; ++k) {
+    if ((route[k] - route.front()).norm() <= min_length) continue;
+    const Vec3 in = route[k] - route[k - 1], out = route[k + 1] - route[k];
+    if (in.norm() < 1e-6 || out.norm() < 1e-6) continue;
+    if (in.normalized().dot(out.normalized()) < cos_corner) return k;
+  }
+  return end;
+}
+
+std::optional<size_t> forward_from(const std::vector<Vec3>& route, const GuidanceFrame& leg,
+                                   double min_cosine) {
+  if (route.size() < 2) return std::nullopt;
+  size_t k = route.size() - 1;
+  while (k > 0) {
+    const Vec3 step = route[k] - route[k - 1];
+    const double advance = leg.world_from_guidance.col(0).dot(step);
+    if (!(advance > 0 && advance >= min_cosine * step.norm())) break;
+    --k;
+  }
+  return k;
+}
+
+Vec3 clear_of_obstacles(const ClearanceQuery& clearance, const Vec3& point, double required,
+                        double max_shift) {
+  if (!clearance) return point;
+  Vec3 p = point;
+  for (int i = 0; i < 20; ++i) {
+    const mapping::DistanceSample d = clearance(p);
+    Vec3 up(d.gradient.x(), d.gradient.y(), 0.0);
+    if (!(d.distance < required) || up.norm() < 1e-6) break;
+    p += up.normalized() * std::min(0.5, required - d.distance + 0.05);
+    if ((p - point).norm() > max_shift) return point;
+  }
+  return p;
+}
+
+void DeadEndRecovery::reset() {
+  decision_ = RecoveryDecision{};
+  stuck_since_.reset();
+  look_end_.reset();
+  turned_ = 0;
+  attempts_ = 0;
+}
+
+void DeadEndRecovery::enter(RecoveryPhase phase, std::string reason) {
+  decision_.phase = phase;
+  decision_.changed = true;
+  decision_.reason = std::move(reason);
+  if (phase != RecoveryPhase::kEscaping &&
+      !(phase == RecoveryPhase::kTurning && after_turn_ == RecoveryPhase::kEscaping))
+    decision_.escape_route.clear();
+  stuck_since_.reset();
+}
+
+bool DeadEndRecovery::stuck(const RecoveryInput& in) {
+  if (in.moving_plan || !(in.velocity.norm() < settings_.hover_speed)) {
+    stuck_since_.reset();
+    return false;
+  }
+  if (!stuck_since_) stuck_since_ = in.time;
+  return in.time - *stuck_since_ >= settings_.stuck_time;
+}
+
+bool DeadEndRecovery::take_route(const RecoveryInput& in) {
+  if (in.route == RouteKind::kNone || in.route == RouteKind::kNoPath) return false;
+  // Any route that does not head along the leg from here (one that turns
+  // back, or goes sideways round a wall first) is flown as an escape: the
+  // forward-only optimiser would take the shorter way straight on, back
+  // into the dead end.
+  const std::vector<Vec3> none;
+  const std::vector<Vec3>& route = in.route_points ? *in.route_points : none;
+  const auto k = escape_leg_end(route, in.leg, settings_.capture_radius);
+  turned_ = 0;
+  last_yaw_ = in.yaw;
+  look_start_ = in.time;
+  facing_since_.reset();
+  if (!k || (route[*k] - in.position).norm() <= settings_.capture_radius) {
+    // Normal planning, once the scanner looks along the leg: a vehicle left
+    // facing the way it came sees nothing ahead, and the commit gate lets
+    // no plan into space no beam has crossed.
+    const Vec3 x = in.leg.world_from_guidance.col(0);
+    face_yaw_ = std::atan2(x.y(), x.x());
+    after_turn_ = RecoveryPhase::kIdle;
+    enter(RecoveryPhase::kTurning,
+          "the route heads along the leg from here: turning to it, then normal planning");
+    return true;
+  }
+  const Vec3 point = route[*k];
+  decision_.escape_from = in.position;
+  decision_.escape_point = point;
+  decision_.escape_route.assign(route.begin(), route.begin() + static_cast<std::ptrdiff_t>(*k) + 1);
+  face_yaw_ = std::atan2(point.y() - in.position.y(), point.x() - in.position.x());
+  after_turn_ = RecoveryPhase::kEscaping;
+  std::ostringstream why;
+  why << "the route does not head along the leg from here: escaping along it, next to ("
+      << point.x() << ", "
+      << point.y() << ", " << point.z() << ") m, "
+      << (point - in.position).norm() << " m away";
+  enter(RecoveryPhase::kTurning, why.str());
+  return true;
+}
+
+RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
+  decision_.changed = false;
+  decision_.reason.clear();
+  if (!settings_.enabled) return decision_;
+  if (!in.engaged) {
+    // Guidance flies the leg: whatever happened, it is over.
+    if (decision_.phase != RecoveryPhase::kIdle) enter(RecoveryPhase::kIdle, "avoidance ended");
+    attempts_ = 0;
+    stuck_since_.reset();
+    return decision_;
+  }
+  auto begin_look = [&](const char* why) {
+    if (attempts_ >= settings_.max_attempts) {
+      std::ostringstream text;
+      text << why << " after " << attempts_ << " look-arounds: holding the hover, no route";
+      enter(RecoveryPhase::kNoRoute, text.str());
+      return;
+    }
+    ++attempts_;
+    turned_ = 0;
+    last_yaw_ = in.yaw;
+    look_start_ = in.time;
+    look_end_.reset();
+    std::ostringstream text;
+    text << why << ": hovering, looking around (" << attempts_ << " of "
+         << settings_.max_attempts << ")";
+    enter(RecoveryPhase::kLooking, text.str());
+  };
+
+  switch (decision_.phase) {
+    case RecoveryPhase::kIdle:
+      if (stuck(in)) begin_look("no way forward");
+      break;
+    case RecoveryPhase::kLooking:
+      if (!look_end_) {
+        turned_ += wrap_angle(in.yaw - last_yaw_);
+        last_yaw_ = in.yaw;
+        if (std::abs(turned_) >= settings_.look_turn ||
+            in.time - look_start_ >= settings_.look_timeout)
+          look_end_ = in.time;
+      } else if (in.time - *look_end_ >= settings_.route_wait && in.route_time >= *look_end_) {
+        if (!take_route(in))
+          enter(RecoveryPhase::kNoRoute, "no route after the look-around: holding the hover");
+      } else if (in.time - *look_end_ >= settings_.route_timeout) {
+        enter(RecoveryPhase::kNoRoute, "no new route after the look-around: holding the hover");
+      }
+      break;
+    case RecoveryPhase::kTurning: {
+      // The controller turns the heading one way at its rate; what follows
+      // starts once it faces the way it will fly (or after a full turn,
+      // whatever it faces then: the map has been swept all round).
+      turned_ += wrap_angle(in.yaw - last_yaw_);
+      last_yaw_ = in.yaw;
+      const bool facing = std::abs(wrap_angle(in.yaw - face_yaw_)) <= settings_.face_tolerance;
+      if (facing && !facing_since_) facing_since_ = in.time;
+      const bool done = (facing_since_ && in.time - *facing_since_ >= settings_.face_hold) ||
+                        std::abs(turned_) >= settings_.look_turn ||
+                        in.time - look_start_ >= settings_.look_timeout;
+      if (done && after_turn_ == RecoveryPhase::kEscaping) {
+        enter(RecoveryPhase::kEscaping, "facing the escape leg: flying it");
+        decision_.escape_from = in.position;
+      } else if (done) {
+        enter(RecoveryPhase::kIdle, "facing along the leg: normal planning");
+      }
+      break;
+    }
+    case RecoveryPhase::kEscaping:
+      if ((in.position - decision_.escape_point).norm() <= settings_.capture_radius &&
+          in.velocity.norm() < settings_.hover_speed) {
+        // A leg done is progress: the looks count again from none. On along
+        // the route as it is now (it starts at the vehicle), or normal
+        // planning when it advances from here.
+        attempts_ = 0;
+        if (!take_route(in)) enter(RecoveryPhase::kIdle, "escape leg done: normal planning");
+      } else if (stuck(in))
+        begin_look("the escape is stuck");
+      break;
+    case RecoveryPhase::kNoRoute:
+      // A route may appear later (an obstacle gone, a better map): taken up
+      // while looks remain.
+      if (attempts_ < settings_.max_attempts && in.route_time > look_start_) take_route(in);
+      break;
+  }
+  return decision_;
+}
+
+}  // namespace ofn::rh

@@ -1,0 +1,288 @@
+// The dead-end recovery's decisions (stuck -> look around -> escape or no
+// route) and the escape legs the planner flies from a hover.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "ofn/rh_optimizer/dead_end_recovery.hpp"
+#include "ofn/rh_optimizer/rh_planner.hpp"
+#include "rh_step_inputs.hpp"
+
+namespace ofn::rh {
+namespace {
+
+using testing_support::field_with;
+using testing_support::kBenchmarkLimits;
+using testing_support::kLegAltitude;
+
+// An escape leg: from a hover, to a point `to` (world NED), stopping there,
+// with the forward-speed rule relaxed, as the service poses it.
+StepInput escape_leg(const Vec3& from, const Vec3& to, ClearanceQuery clearance) {
+  StepInput in;
+  in.time = 100.0;
+  RhProblem& p = in.problem;
+  p.frame = GuidanceFrame::from_leg(from, to);
+  p.position = from;
+  p.target = to;
+  p.terminal_x = p.frame.to_guidance(to).x();
+  p.stop_at_target = true;
+  p.limits = kBenchmarkLimits;
+  p.limits.min_forward_speed = -kBenchmarkLimits.max_speed;
+  p.clearance = std::move(clearance);
+  in.global_path = {from, to};
+  in.global_path_changed = true;
+  return in;
+}
+
+TEST(EscapeLeg, ShortLegsFromAHoverAreSolved) {
+  for (const double length : {8.0, 15.0, 30.0, 60.0}) {
+    RhPlanner planner;
+    const Vec3 from(50, 0, -kLegAltitude);
+    const Vec3 to(50, -length, -kLegAltitude);
+    const StepOutput out = planner.step(escape_leg(from, to, field_with({})));
+    EXPECT_EQ(out.mode, StepMode::kSolved) << length << " m: " << out.reason;
+    if (out.mode == StepMode::kSolved) {
+      const BsplineTrajectory& t = out.trajectory;
+      EXPECT_LT((t.position(t.duration()) - to).norm(), 0.5) << length;
+      EXPECT_LT(t.velocity(t.duration()).norm(), 0.1) << length;
+    }
+  }
+}
+
+// A stop that ended a few centimetres inside R_s plus the planning margin
+// (here 6.4 m from a wall, 6.6 m planned): from that hover a plan away from
+// the wall must be feasible. It was not while the requirement grew at the
+// speed limit from t = 0, faster than a vehicle at rest can move.
+TEST(EscapeLeg, FromAHoverJustInsideThePlannedClearance) {
+  using testing_support::Box;
+  RhSettings settings;
+  settings.clearance_margin = 0.5;
+  RhPlanner planner(settings);
+  // A wall at north 40..43, the vehicle 6.4 m short of it, leaving south.
+  // The field measures from cell centres: the face cell's centre is 40.5.
+  const Vec3 from(40.5 - 6.4, 0, -kLegAltitude);
+  const Vec3 to(from.x() - 20.0, 0, -kLegAltitude);
+  const StepInput in = escape_leg(from, to, field_with({Box{40, 43, -60, 60, 150.0f}}));
+  ASSERT_LT(in.problem.clearance(from).distance, kBenchmarkLimits.clearance + 0.5);
+  ASSERT_GT(in.problem.clearance(from).distance, kBenchmarkLimits.clearance);
+  const StepOutput out = planner.step(in);
+  EXPECT_EQ(out.mode, StepMode::kSolved) << out.reason;
+}
+
+}  // namespace
+}  // namespace ofn::rh
+
+namespace ofn::rh {
+namespace {
+
+// The mission leg: north from the origin, at 36.6 m.
+const GuidanceFrame kLeg =
+    GuidanceFrame::from_leg(Vec3(0, 0, -36.6), Vec3(150, 0, -36.6));
+
+RecoverySettings settings() {
+  RecoverySettings s;
+  s.stuck_time = 4.0;
+  s.route_wait = 3.0;
+  s.route_timeout = 10.0;
+  s.max_attempts = 2;
+  return s;
+}
+
+// One recovery, fed at 10 Hz from a hovering vehicle whose heading the
+// test turns.
+class RecoveryRun {
+ public:
+  explicit RecoveryRun(RecoverySettings s = settings()) : recovery(s) {
+    in.engaged = true;
+    in.position = Vec3(80, 0, -36.6);
+    in.leg = kLeg;
+    in.route_points = &route;
+  }
+  RecoveryDecision step(double dt = 0.1) {
+    in.time += dt;
+    return recovery.update(in);
+  }
+  /// Steps for `seconds`, turning the heading at `yaw_rate`.
+  RecoveryDecision run(double seconds, double yaw_rate = 0.0) {
+    RecoveryDecision d;
+    for (double t = 0; t < seconds - 1e-9; t += 0.1) {
+      in.yaw = wrap_angle(in.yaw + yaw_rate * 0.1);
+      d = step();
+    }
+    return d;
+  }
+  /// Turns until the recovery leaves `phase` (at most `limit` s).
+  RecoveryDecision turn_out_of(RecoveryPhase phase, double limit = 60.0) {
+    RecoveryDecision d = recovery.update(in);
+    for (double t = 0; t < limit && recovery.phase() == phase; t += 0.1) {
+      in.yaw = wrap_angle(in.yaw + 0.5 * 0.1);
+      d = step();
+    }
+    return d;
+  }
+  void give_route(RouteKind kind, std::vector<Vec3> points) {
+    in.route = kind;
+    in.route_time = in.time;
+    route = std::move(points);
+  }
+
+  DeadEndRecovery recovery;
+  RecoveryInput in;
+  std::vector<Vec3> route;
+};
+
+// A route out of a U whose opening is behind the vehicle: back south, then
+// east round the side wall, then north along it (2 m spacing).
+std::vector<Vec3> route_out_of_the_u(const Vec3& from) {
+  const std::vector<Vec3> corners = {from, Vec3(20, 0, -36.6), Vec3(20, 45, -36.6),
+                                     Vec3(100, 45, -36.6), Vec3(150, 0, -36.6)};
+  std::vector<Vec3> points{corners.front()};
+  for (size_t k = 1; k < corners.size(); ++k) {
+    const Vec3 a = corners[k - 1], b = corners[k];
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 2.0)));
+    for (int i = 1; i <= n; ++i) points.push_back(a + (b - a) * (double(i) / n));
+  }
+  return points;
+}
+
+TEST(DeadEndRecovery, LooksAroundOnlyAfterHoveringWithoutAPlanForTheStuckTime) {
+  RecoveryRun r;
+  EXPECT_EQ(r.run(3.9).phase, RecoveryPhase::kIdle);
+  const RecoveryDecision d = r.run(0.2);
+  EXPECT_EQ(d.phase, RecoveryPhase::kLooking);
+  EXPECT_EQ(r.recovery.attempts(), 1);
+
+  // A plan that moves off, or a vehicle that moves, is not stuck.
+  RecoveryRun moving;
+  moving.in.moving_plan = true;
+  EXPECT_EQ(moving.run(10).phase, RecoveryPhase::kIdle);
+  RecoveryRun flying;
+  flying.in.velocity = Vec3(1.0, 0, 0);
+  EXPECT_EQ(flying.run(10).phase, RecoveryPhase::kIdle);
+  // Nor is one that waypoint guidance flies.
+  RecoveryRun guided;
+  guided.in.engaged = false;
+  EXPECT_EQ(guided.run(10).phase, RecoveryPhase::kIdle);
+}
+
+TEST(DeadEndRecovery, TheLookEndsAfterAFullTurnAndARouteMadeSince) {
+  RecoveryRun r;
+  r.run(4.1);
+  ASSERT_EQ(r.recovery.phase(), RecoveryPhase::kLooking);
+  // Half a turn and a route: still looking.
+  r.give_route(RouteKind::kForward, {r.in.position, Vec3(150, 0, -36.6)});
+  EXPECT_EQ(r.run(2 * M_PI / 0.5 / 2, 0.5).phase, RecoveryPhase::kLooking);
+  // The rest of the turn; a route older than the look's end is not taken.
+  r.run(2 * M_PI / 0.5 / 2 + 0.2, 0.5);
+  EXPECT_EQ(r.run(5).phase, RecoveryPhase::kLooking);
+  // A route made after the look, heading along the leg: turn to face the
+  // leg (north), then normal planning.
+  r.give_route(RouteKind::kForward, {r.in.position, Vec3(150, 0, -36.6)});
+  r.in.yaw = 2.0;
+  EXPECT_EQ(r.run(0.1).phase, RecoveryPhase::kTurning);
+  const RecoveryDecision d = r.turn_out_of(RecoveryPhase::kTurning);
+  EXPECT_EQ(d.phase, RecoveryPhase::kIdle);
+  EXPECT_LE(std::abs(wrap_angle(r.in.yaw)), settings().face_tolerance + 0.05);
+}
+
+TEST(DeadEndRecovery, EscapesLegByLegAlongARouteThatTurnsBack) {
+  RecoveryRun r;
+  r.run(4.1);
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);  // the look
+  r.give_route(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+  r.run(3.1);
+  ASSERT_EQ(r.recovery.phase(), RecoveryPhase::kTurning);
+  // The first leg ends at the first corner, (20, 0): facing south first.
+  RecoveryDecision d = r.turn_out_of(RecoveryPhase::kTurning);
+  ASSERT_EQ(d.phase, RecoveryPhase::kEscaping);
+  EXPECT_LT((d.escape_point - Vec3(20, 0, -36.6)).norm(), 1e-9);
+  EXPECT_LT(std::abs(wrap_angle(r.in.yaw - M_PI)), settings().face_tolerance + 0.05);
+  ASSERT_FALSE(d.escape_route.empty());
+  EXPECT_LT((d.escape_route.back() - d.escape_point).norm(), 1e-9);
+  // Flying it is not being stuck.
+  r.in.velocity = Vec3(-1.5, 0, 0);
+  EXPECT_EQ(r.run(10).phase, RecoveryPhase::kEscaping);
+  // At the corner, at rest: the route from there (it starts at the vehicle)
+  // gives the next leg, east to (20, 45), after which the route heads north.
+  r.in.position = Vec3(20.5, 0, -36.6);
+  r.in.velocity = Vec3::Zero();
+  r.give_route(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+  d = r.step();
+  ASSERT_EQ(d.phase, RecoveryPhase::kTurning);
+  d = r.turn_out_of(RecoveryPhase::kTurning);
+  ASSERT_EQ(d.phase, RecoveryPhase::kEscaping);
+  EXPECT_LT((d.escape_point - Vec3(20, 45, -36.6)).norm(), 1e-9);
+  EXPECT_EQ(r.recovery.attempts(), 0);  // a leg done counts as progress
+  // There, the route heads along the leg: face north, then normal planning.
+  r.in.position = Vec3(20, 44, -36.6);
+  r.give_route(RouteKind::kForward, {r.in.position, Vec3(100, 45, -36.6), Vec3(150, 0, -36.6)});
+  EXPECT_EQ(r.step().phase, RecoveryPhase::kTurning);
+  EXPECT_EQ(r.turn_out_of(RecoveryPhase::kTurning).phase, RecoveryPhase::kIdle);
+}
+
+TEST(DeadEndRecovery, NoRouteAfterTheLookHoldsTheHoverAndSaysSo) {
+  RecoveryRun r;
+  r.run(4.1);
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  r.give_route(RouteKind::kNoPath, {});
+  RecoveryDecision d = r.run(3.1);
+  EXPECT_EQ(d.phase, RecoveryPhase::kNoRoute);
+  EXPECT_EQ(r.run(30).phase, RecoveryPhase::kNoRoute);
+  // No route heard at all after the look: no route too, at the timeout.
+  RecoveryRun silent;
+  silent.run(4.1);
+  silent.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  EXPECT_EQ(silent.run(9.5).phase, RecoveryPhase::kLooking);
+  EXPECT_EQ(silent.run(0.6).phase, RecoveryPhase::kNoRoute);
+  // A route that appears later (the map changed) is taken up.
+  r.give_route(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+  EXPECT_EQ(r.step().phase, RecoveryPhase::kTurning);
+}
+
+TEST(DeadEndRecovery, AnEscapeStuckTooOftenEndsInNoRoute) {
+  RecoveryRun r;  // max_attempts 2
+  for (int attempt = 1; attempt <= 2; ++attempt) {
+    r.run(4.1);
+    ASSERT_EQ(r.recovery.phase(), RecoveryPhase::kLooking) << attempt;
+    EXPECT_EQ(r.recovery.attempts(), attempt);
+    r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+    r.give_route(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+    r.run(3.1);
+    ASSERT_EQ(r.turn_out_of(RecoveryPhase::kTurning).phase, RecoveryPhase::kEscaping);
+    // No plan moves off: stuck again.
+  }
+  EXPECT_EQ(r.run(4.1).phase, RecoveryPhase::kNoRoute);
+  EXPECT_EQ(r.run(60).phase, RecoveryPhase::kNoRoute);
+  // The hand-back to guidance ends it all.
+  r.in.engaged = false;
+  EXPECT_EQ(r.step().phase, RecoveryPhase::kIdle);
+  EXPECT_EQ(r.recovery.attempts(), 0);
+}
+
+TEST(DeadEndRecovery, DisabledItNeverActs) {
+  RecoverySettings s = settings();
+  s.enabled = false;
+  RecoveryRun r(s);
+  EXPECT_EQ(r.run(60).phase, RecoveryPhase::kIdle);
+}
+
+TEST(DeadEndRecovery, RouteShapes) {
+  const Vec3 a(80, 0, -36.6);
+  const std::vector<Vec3> out_of_u = route_out_of_the_u(a);
+  // The route heads along the leg from (20, 45) on; its first corner is (20, 0).
+  const auto forward = forward_from(out_of_u, kLeg);
+  ASSERT_TRUE(forward);
+  EXPECT_LT((out_of_u[*forward] - Vec3(20, 45, -36.6)).norm(), 1e-9);
+  const auto leg_end = escape_leg_end(out_of_u, kLeg);
+  ASSERT_TRUE(leg_end);
+  EXPECT_LT((out_of_u[*leg_end] - Vec3(20, 0, -36.6)).norm(), 1e-9);
+  // A route straight on heads along the leg from its start.
+  EXPECT_EQ(forward_from({a, Vec3(100, 5, -36.6), Vec3(150, 0, -36.6)}, kLeg), size_t{0});
+  // Too short to say.
+  EXPECT_FALSE(forward_from({a}, kLeg));
+}
+
+}  // namespace
+}  // namespace ofn::rh
