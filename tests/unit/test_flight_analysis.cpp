@@ -92,6 +92,23 @@ TEST(AnalyseFlight, GateToGateAtTenMetresPerSecond) {
   EXPECT_FALSE(s.reached_last_waypoint);
 }
 
+// Backing out of a dead end flies south on purpose: the forward-speed rule
+// is relaxed there, and only there (plus the settling time after it).
+TEST(AnalyseFlight, ForwardSpeedIsNotCountedInADeadEndRecovery) {
+  auto samples = straight_run();
+  for (auto& n : samples)
+    if (n.t >= 20.0 && n.t <= 22.0) n.velocity = Vec3(-1.0, 0, 0);
+  EXPECT_NEAR(analyse_flight(samples, {}, limits(), 0.0, 400.0).min_forward_speed, -1.0, 1e-12);
+  const FlightSummary s =
+      analyse_flight(samples, {}, limits(), 0.0, 400.0, {TimeSpan{19.0, 20.5}});
+  EXPECT_NEAR(s.min_forward_speed, 10.0, 1e-12);
+  EXPECT_NEAR(s.recovery_time, 1.5, 1e-12);
+  // A span that ends long before does not cover it.
+  EXPECT_NEAR(
+      analyse_flight(samples, {}, limits(), 0.0, 400.0, {TimeSpan{12.0, 14.0}}).min_forward_speed,
+      -1.0, 1e-12);
+}
+
 TEST(AnalyseFlight, GateBetweenSamplesIsInterpolated) {
   const auto samples = straight_run();
   const FlightSummary s = analyse_flight(samples, {}, limits(), 0.25, 400.75);

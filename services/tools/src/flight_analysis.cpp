@@ -29,8 +29,15 @@ bool flies_a_plan(int mode) {
 
 FlightSummary analyse_flight(const std::vector<NavSample>& nav,
                              const std::vector<StatusSample>& status, const Limits& limits,
-                             std::optional<double> start_gate, std::optional<double> finish_gate) {
+                             std::optional<double> start_gate, std::optional<double> finish_gate,
+                             const std::vector<TimeSpan>& recovery) {
   FlightSummary s;
+  for (const TimeSpan& span : recovery) s.recovery_time += std::max(0.0, span.end - span.begin);
+  const auto recovering = [&recovery](double t) {
+    for (const TimeSpan& span : recovery)
+      if (t >= span.begin && t <= span.end + kRecoverySettle) return true;
+    return false;
+  };
   if (!nav.empty()) s.duration = nav.back().t - nav.front().t;
   for (const auto& n : nav) {
     s.max_speed = std::max(s.max_speed, n.velocity.norm());
@@ -51,7 +58,7 @@ FlightSummary analyse_flight(const std::vector<NavSample>& nav,
     s.gate_to_gate = *s.gate_finish_time - *s.gate_start_time;
     bool first = true;
     for (const auto& n : nav) {
-      if (n.t < *s.gate_start_time || n.t > *s.gate_finish_time) continue;
+      if (n.t < *s.gate_start_time || n.t > *s.gate_finish_time || recovering(n.t)) continue;
       s.min_forward_speed = first ? n.velocity.x() : std::min(s.min_forward_speed, n.velocity.x());
       first = false;
     }

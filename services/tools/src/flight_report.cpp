@@ -115,6 +115,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   int path_seq = 0, ref_seq = 0, ref_seen = 0;
   std::vector<double> solve_times;
   std::map<int, int> solver_status_count;
+  std::vector<TimeSpan> recovery;
   auto row = [](std::ofstream& f, std::initializer_list<Vec3> vs) {
     for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
   };
@@ -202,6 +203,18 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
         ++solver_status_count[m.status];
         solve_times.push_back(m.solve_time);
       }
+      // The dead-end recovery's steps, joined into spans (the optimiser
+      // reports at 5-20 Hz; a gap of a second ends a span).
+      const bool recovering = m.status == solver_stats_t::LOOKING_AROUND ||
+                              m.status == solver_stats_t::NO_ROUTE ||
+                              m.message.rfind("escaping", 0) == 0;
+      if (recovering) {
+        const double t = rel(m.utime);
+        if (!recovery.empty() && t - recovery.back().end <= 1.0)
+          recovery.back().end = t;
+        else
+          recovery.push_back({t, t});
+      }
     } else if (channel == channels::kMission) {
       mission_t m{};
       if (!decode(e, m)) return false;
@@ -273,7 +286,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   result.min_clearance = min_clearance;
   const auto start_gate = scenario ? scenario->start_gate : std::nullopt;
   const auto finish_gate = scenario ? scenario->finish_gate : std::nullopt;
-  result.summary = analyse_flight(nav, status, limits, start_gate, finish_gate);
+  result.summary = analyse_flight(nav, status, limits, start_gate, finish_gate, recovery);
   const FlightSummary& s = result.summary;
 
   const std::string unit = scenario ? scenario->display_unit : "m";
@@ -327,6 +340,10 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"rh_kept_previous\": " << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ",\n"
        << "  \"rh_braking\": " << solver_status_count[solver_stats_t::BRAKING] << ",\n"
        << "  \"rh_deferred\": " << solver_status_count[solver_stats_t::DEFERRED] << ",\n"
+       << "  \"rh_looking_around\": " << solver_status_count[solver_stats_t::LOOKING_AROUND]
+       << ",\n"
+       << "  \"rh_no_route\": " << solver_status_count[solver_stats_t::NO_ROUTE] << ",\n"
+       << "  \"recovery_time\": " << s.recovery_time << ",\n"
        << "  \"outcome\": \"" << to_string(result.verdict.outcome) << "\",\n"
        << "  \"success\": " << (result.verdict.success ? "true" : "false") << ",\n"
        << "  \"failures\": [";
@@ -408,7 +425,10 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       << std::setprecision(2) << " ms; kept previous "
       << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ", braking "
       << solver_status_count[solver_stats_t::BRAKING] << ", deferred "
-      << solver_status_count[solver_stats_t::DEFERRED] << "\n";
+      << solver_status_count[solver_stats_t::DEFERRED] << ", looking around "
+      << solver_status_count[solver_stats_t::LOOKING_AROUND] << ", no route "
+      << solver_status_count[solver_stats_t::NO_ROUTE] << "; " << std::setprecision(1)
+      << s.recovery_time << " s in dead-end recovery\n" << std::setprecision(2);
   } else {
     t << "  RH optimiser      : never engaged (nominal waypoint guidance throughout)\n";
   }

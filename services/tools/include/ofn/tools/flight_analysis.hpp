@@ -35,9 +35,10 @@ struct FlightSummary {
   std::optional<double> gate_to_gate;                       // s
   double max_speed = 0;                                     // m/s, whole flight
   double max_vertical_speed = 0;                            // m/s
-  /// m/s, least velocity along the course (north) between the gates; the
-  /// limits ask for >= 0. Zero without both gates.
+  /// m/s, least velocity along the course (north) between the gates, outside
+  /// the recovery spans; the limits ask for >= 0. Zero without both gates.
   double min_forward_speed = 0;
+  double recovery_time = 0;  // s of the flight in a dead-end recovery
   /// m/s, largest speed over the last kHoverWindow of navigation data;
   /// none when the data is shorter than that. Tells a hover at the end.
   std::optional<double> final_max_speed;
@@ -136,8 +137,19 @@ std::optional<double> crossing_time(const std::vector<NavSample>& nav, double x)
 /// but holding before a mission, lost navigation and holding after arrival.
 bool flies_a_plan(int mode);
 
+/// A time span (s, the navigation samples' clock) in which the RH optimiser
+/// reported a dead-end recovery (looking around, escaping, no route): the
+/// forward-speed rule is relaxed there by design, so the verdict does not
+/// count the forward speed within it or within kRecoverySettle after it.
+struct TimeSpan {
+  double begin = 0;
+  double end = 0;
+};
+constexpr double kRecoverySettle = 2.0;  // s
+
 FlightSummary analyse_flight(const std::vector<NavSample>& nav,
                              const std::vector<StatusSample>& status, const Limits& limits,
-                             std::optional<double> start_gate, std::optional<double> finish_gate);
+                             std::optional<double> start_gate, std::optional<double> finish_gate,
+                             const std::vector<TimeSpan>& recovery = {});
 
 }  // namespace ofn::report
