@@ -575,6 +575,10 @@ TEST(RhOptimizer, RequiredClearanceLetsAStartInsideClimbOut) {
               1e-12);
   EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 4.0, 30.0), planned);
   EXPECT_NEAR(optimizer.required_clearance(problem, -2.0, delay + 1.0), 0.5 * accel, 1e-12);
+  // A start at the speed limit: the ramp at the speed limit from t = 0.
+  RhProblem moving = problem;
+  moving.velocity = Vec3(3.0, 0, 0);
+  EXPECT_NEAR(optimizer.required_clearance(moving, 4.0, 0.5), 4.0 + speed * 0.5, 1e-12);
   const double t_full = delay + speed / accel;  // at the speed limit from then on
   problem.limits.clearance = 100.0;             // not reached by then
   EXPECT_NEAR(optimizer.required_clearance(problem, 0.0, t_full + 0.1) -

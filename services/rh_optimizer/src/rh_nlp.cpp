@@ -37,6 +37,7 @@ PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhP
       clearance_norm_(std::max(problem.limits.clearance + settings.clearance_margin, 1.0)),
       tau_(settings.time_constants),
       max_speed_((1.0 - settings.speed_margin) * problem.limits.max_speed),
+      start_speed_(std::min(problem.velocity.norm(), max_speed_)),
       max_vertical_speed_((1.0 - settings.speed_margin) * problem.limits.max_vertical_speed),
       min_forward_speed_(problem.limits.min_forward_speed),
       max_accel_((1.0 - settings.accel_margin) * problem.limits.max_accel),
@@ -47,22 +48,32 @@ PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhP
 double PointConstraintModel::required_clearance(double t, double* derivative) const {
   if (derivative) *derivative = 0;
   if (start_clearance_ >= planned_clearance_) return planned_clearance_;
-  // As far as a vehicle could get from rest in t: after the largest
-  // acceleration time constant (the commanded-acceleration limit of Eq. 4
-  // holds the acceleration back for about that long), at half the
-  // acceleration limit up to the speed limit, then at it. A ramp at the
-  // speed limit from t = 0 cannot be met from a hover: a stop that ended a
-  // few centimetres inside R_plan made every plan infeasible, and the
-  // vehicle stayed.
+  // At the speed limit from t = 0, as far as a vehicle at the speed limit
+  // could get; no farther than one at the start's speed could, speeding up
+  // after the largest acceleration time constant (the commanded-
+  // acceleration limit of Eq. 4 holds the acceleration back about that
+  // long) at half the acceleration limit. The speed-limit ramp alone cannot
+  // be met from a hover: a stop that ended a few centimetres inside R_plan
+  // made every plan infeasible, and the vehicle stayed.
   const double delay = tau_.maxCoeff();
   const double accel = 0.5 * max_accel_;
-  const double t_full = accel > 0 ? max_speed_ / accel : 0.0;
   const double moving = std::max(0.0, t - delay);
-  const double gained =
-      moving < t_full ? 0.5 * accel * moving * moving : max_speed_ * (moving - 0.5 * t_full);
+  const double t_full = accel > 0 ? (max_speed_ - start_speed_) / accel : 0.0;
+  double gained = start_speed_ * t, rate = start_speed_;
+  if (moving < t_full) {
+    gained += 0.5 * accel * moving * moving;
+    rate += accel * moving;
+  } else {
+    gained += (max_speed_ - start_speed_) * (moving - 0.5 * t_full);
+    rate = max_speed_;
+  }
+  if (max_speed_ * t <= gained) {
+    gained = max_speed_ * t;
+    rate = max_speed_;
+  }
   const double climbing = std::max(start_clearance_, 0.0) + gained;
   if (climbing >= planned_clearance_) return planned_clearance_;
-  if (derivative) *derivative = moving < t_full ? accel * moving : max_speed_;
+  if (derivative) *derivative = rate;
   return climbing;
 }
 

@@ -66,7 +66,9 @@ class PointConstraintModel {
   double start_clearance_;
   double clearance_norm_;
   Vec3 tau_;
-  double max_speed_, max_vertical_speed_, min_forward_speed_, max_accel_;
+  double max_speed_;
+  double start_speed_;  // |v0|, at most max_speed_
+  double max_vertical_speed_, min_forward_speed_, max_accel_;
   double min_altitude_, altitude_norm_, ground_altitude_;
 };
 
