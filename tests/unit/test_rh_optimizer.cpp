@@ -563,9 +563,9 @@ TEST(RhOptimizer, RequiredClearanceLetsAStartInsideClimbOut) {
   problem.limits = Limits{3.0, 0.5, 1.5, 0.0, 6.0, 60.0};
   const double planned = 6.0 + optimizer.settings().clearance_margin;
   EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 20.0, 0.0), planned);
-  // From the start clearance up as far as the vehicle could get from rest:
-  // after the largest time constant, at half the acceleration limit, then
-  // at the speed limit (each less its margin).
+  // From a hover, the start clearance up as far as the vehicle could get
+  // from rest: after the largest time constant, at half the acceleration
+  // limit, then at the speed limit (each less its margin).
   const double delay = optimizer.settings().time_constants.maxCoeff();
   const double accel = 0.5 * (1.0 - optimizer.settings().accel_margin) * 0.5;
   const double speed = (1.0 - optimizer.settings().speed_margin) * 3.0;
@@ -575,9 +575,9 @@ TEST(RhOptimizer, RequiredClearanceLetsAStartInsideClimbOut) {
               1e-12);
   EXPECT_DOUBLE_EQ(optimizer.required_clearance(problem, 4.0, 30.0), planned);
   EXPECT_NEAR(optimizer.required_clearance(problem, -2.0, delay + 1.0), 0.5 * accel, 1e-12);
-  // A start at the speed limit: the ramp at the speed limit from t = 0.
+  // A moving start: the ramp at the speed limit from t = 0.
   RhProblem moving = problem;
-  moving.velocity = Vec3(3.0, 0, 0);
+  moving.velocity = Vec3(1.0, 0, 0);
   EXPECT_NEAR(optimizer.required_clearance(moving, 4.0, 0.5), 4.0 + speed * 0.5, 1e-12);
   const double t_full = delay + speed / accel;  // at the speed limit from then on
   problem.limits.clearance = 100.0;             // not reached by then

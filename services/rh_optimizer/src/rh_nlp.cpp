@@ -25,6 +25,10 @@ void gauss_legendre(int points, Eigen::VectorXd& nodes, Eigen::VectorXd& weights
 
 }  // namespace
 
+/// Below this start speed (m/s) a plan starts from a hover (see
+/// required_clearance).
+constexpr double kHoverStartSpeed = 0.3;
+
 // ---------------------------------------------------------------------------
 
 PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhProblem& problem,
@@ -48,28 +52,23 @@ PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhP
 double PointConstraintModel::required_clearance(double t, double* derivative) const {
   if (derivative) *derivative = 0;
   if (start_clearance_ >= planned_clearance_) return planned_clearance_;
-  // At the speed limit from t = 0, as far as a vehicle at the speed limit
-  // could get; no farther than one at the start's speed could, speeding up
-  // after the largest acceleration time constant (the commanded-
-  // acceleration limit of Eq. 4 holds the acceleration back about that
-  // long) at half the acceleration limit. The speed-limit ramp alone cannot
-  // be met from a hover: a stop that ended a few centimetres inside R_plan
-  // made every plan infeasible, and the vehicle stayed.
-  const double delay = tau_.maxCoeff();
-  const double accel = 0.5 * max_accel_;
-  const double moving = std::max(0.0, t - delay);
-  const double t_full = accel > 0 ? (max_speed_ - start_speed_) / accel : 0.0;
-  double gained = start_speed_ * t, rate = start_speed_;
-  if (moving < t_full) {
-    gained += 0.5 * accel * moving * moving;
-    rate += accel * moving;
-  } else {
-    gained += (max_speed_ - start_speed_) * (moving - 0.5 * t_full);
-    rate = max_speed_;
-  }
-  if (max_speed_ * t <= gained) {
-    gained = max_speed_ * t;
-    rate = max_speed_;
+  // At the speed limit from t = 0, except from a hover: a vehicle at rest
+  // cannot meet that ramp, and from a stop that ended a few centimetres
+  // inside R_plan every plan was infeasible and the vehicle stayed. From a
+  // hover the requirement grows as far as the vehicle could get: nothing
+  // for the largest acceleration time constant (the commanded-acceleration
+  // limit of Eq. 4 holds the acceleration back about that long), then at
+  // half the acceleration limit up to the speed limit. (Relaxing it for a
+  // moving start too let dense-field plans linger near obstacles: fewer
+  // fields succeeded.)
+  double gained = max_speed_ * t, rate = max_speed_;
+  if (start_speed_ < kHoverStartSpeed) {
+    const double delay = tau_.maxCoeff();
+    const double accel = 0.5 * max_accel_;
+    const double moving = std::max(0.0, t - delay);
+    const double t_full = accel > 0 ? max_speed_ / accel : 0.0;
+    gained = moving < t_full ? 0.5 * accel * moving * moving : max_speed_ * (moving - 0.5 * t_full);
+    rate = moving < t_full ? accel * moving : max_speed_;
   }
   const double climbing = std::max(start_clearance_, 0.0) + gained;
   if (climbing >= planned_clearance_) return planned_clearance_;

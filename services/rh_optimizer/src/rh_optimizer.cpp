@@ -28,8 +28,6 @@ constexpr double kRelativeStepTolerance = 1e-7;
 // with: well inside it, so that the commanded acceleration (a + tau da/dt)
 // of the fitted spline stays inside too.
 constexpr double kGuessAccelFraction = 0.5;
-// m of the route over which its leaving direction is taken.
-constexpr double kGuessHeadingLength = 5.0;
 
 /// Distance along a path against time: from v0 up to `speed` at `accel`,
 /// on at `speed`, and down to rest at the end when `stop`; a path too short
@@ -536,13 +534,9 @@ InitialGuess RhOptimizer::guess_from_path(const std::vector<Vec3>& path, const R
   // escape) it speeds up first, and a plan that stops at its target slows
   // down at the end: a constant pace would ask for a step in velocity there,
   // which SLSQP may not smooth out within the acceleration limits.
-  // The speed it starts with is the vehicle's along the way the route
-  // leaves (over its first metres: the hop onto the polyline may be
-  // sideways), so a route that turns away from the velocity starts slower.
-  Vec3 first = Vec3::Zero();
-  for (size_t i = 1; i < route.size() && first.norm() < kGuessHeadingLength; ++i)
-    first = route[i] - route[0];
-  first = first.norm() > 1e-9 ? first.normalized() : Vec3::UnitX();
+  // It starts at the vehicle's speed along the route's first step: a route
+  // that turns away from the velocity starts slower.
+  const Vec3 first = route.size() > 1 ? (route[1] - route[0]).normalized() : Vec3::UnitX();
   const SpeedProfile profile(std::clamp(problem.velocity.dot(first), 0.0, speed), speed,
                              kGuessAccelFraction * problem.limits.max_accel, length,
                              problem.stop_at_target);
