@@ -78,8 +78,7 @@ namespace ofn::rh {
 namespace {
 
 // The mission leg: north from the origin, at 36.6 m.
-const GuidanceFrame kLeg =
-    GuidanceFrame::from_leg(Vec3(0, 0, -36.6), Vec3(150, 0, -36.6));
+const GuidanceFrame kLeg = GuidanceFrame::from_leg(Vec3(0, 0, -36.6), Vec3(150, 0, -36.6));
 
 RecoverySettings settings() {
   RecoverySettings s;

@@ -99,8 +99,7 @@ TEST(AnalyseFlight, ForwardSpeedIsNotCountedInADeadEndRecovery) {
   for (auto& n : samples)
     if (n.t >= 20.0 && n.t <= 22.0) n.velocity = Vec3(-1.0, 0, 0);
   EXPECT_NEAR(analyse_flight(samples, {}, limits(), 0.0, 400.0).min_forward_speed, -1.0, 1e-12);
-  const FlightSummary s =
-      analyse_flight(samples, {}, limits(), 0.0, 400.0, {TimeSpan{19.0, 20.5}});
+  const FlightSummary s = analyse_flight(samples, {}, limits(), 0.0, 400.0, {TimeSpan{19.0, 20.5}});
   EXPECT_NEAR(s.min_forward_speed, 10.0, 1e-12);
   EXPECT_NEAR(s.recovery_time, 1.5, 1e-12);
   // A span that ends long before does not cover it.

@@ -412,9 +412,9 @@ TEST(MappingTops, ATopNoBeamWentOverStandsAtTheCeiling) {
     const ObstacleSpec& wall = scenario.obstacles.at(0);
     double top = 0;
     fly_and_map(scenario, {{-100, 0, 120}, {120, 0, 120}}, {}, [&](mapping::Mapper& m, double t) {
-      if (t > 14.0) top = std::max(top, grid_top_within(m, wall.north - 10 * kFt,
-                                                         wall.north + 10 * kFt, -200 * kFt,
-                                                         200 * kFt));
+      if (t > 14.0)
+        top = std::max(top, grid_top_within(m, wall.north - 10 * kFt, wall.north + 10 * kFt,
+                                            -200 * kFt, 200 * kFt));
     });
     EXPECT_GT(top, wall.height - tol);
     EXPECT_LT(top, wall.height + tol);
@@ -425,8 +425,8 @@ TEST(MappingTops, ATopNoBeamWentOverStandsAtTheCeiling) {
     mapping::MapperConfig config;
     double top = 0;
     fly_and_map(scenario, {{-100, 0, 120}, {240, 0, 120}}, {}, [&](mapping::Mapper& m, double t) {
-      if (t > 30.0) top = grid_top_within(m, back.north - 10 * kFt, back.north + 10 * kFt,
-                                          -20 * kFt, 20 * kFt);
+      if (t > 30.0)
+        top = grid_top_within(m, back.north - 10 * kFt, back.north + 10 * kFt, -20 * kFt, 20 * kFt);
     });
     EXPECT_GE(top, config.grid.ceiling - 1e-3);
   }

@@ -459,6 +459,16 @@ class Problem {
   int segments_checked_ = 0;
 };
 
+/// Node 0 -> node 1 by the parents the search closed them with; empty when
+/// the goal (node 1) was never reached.
+std::vector<int> sequence_to_goal(const std::vector<char>& closed, const std::vector<int>& parent) {
+  if (!closed[1]) return {};
+  std::vector<int> sequence;
+  for (int v = 1; v >= 0; v = parent[v]) sequence.push_back(v);
+  std::reverse(sequence.begin(), sequence.end());
+  return sequence;
+}
+
 struct Entry {
   double f;  // cost so far plus the straight distance to the goal
   double g;
@@ -552,11 +562,7 @@ std::vector<int> search(Problem& problem) {
       open.push({offer + h[e.node], offer, e.node, u, true});
     }
   }
-  if (!closed[1]) return {};
-  std::vector<int> sequence;
-  for (int v = 1; v >= 0; v = parent[v]) sequence.push_back(v);
-  std::reverse(sequence.begin(), sequence.end());
-  return sequence;
+  return sequence_to_goal(closed, parent);
 }
 
 /// Shortest node sequence 0 -> 1 with segments in any direction: the way
@@ -569,14 +575,15 @@ std::vector<int> search(Problem& problem) {
 std::vector<int> search_any_direction(Problem& problem) {
   const int n = problem.size();
   const Vec3 goal = problem.nodes()[1];
-  std::vector<double> g(n, kInf);
   std::vector<int> parent(n, -1);
   std::vector<char> closed(n, 0);
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  // Closes v at `cost` by way of `from` and offers every open node from it
+  // (the goal closes the search instead).
   auto close = [&](int v, double cost, int from) {
     closed[v] = 1;
-    g[v] = cost;
     parent[v] = from;
+    if (v == 1) return;
     for (int w = 1; w < n; ++w) {
       if (closed[w] || w == v) continue;
       const double offer = cost + problem.length(v, w);
@@ -584,23 +591,12 @@ std::vector<int> search_any_direction(Problem& problem) {
     }
   };
   close(0, 0.0, -1);
-  while (!open.empty()) {
+  while (!open.empty() && !closed[1]) {
     const Entry e = open.top();
     open.pop();
-    if (closed[e.node] || problem.blocked(e.parent, e.node)) continue;
-    if (e.node == 1) {
-      g[1] = e.g;
-      parent[1] = e.parent;
-      closed[1] = 1;
-      break;
-    }
-    close(e.node, e.g, e.parent);
+    if (!closed[e.node] && !problem.blocked(e.parent, e.node)) close(e.node, e.g, e.parent);
   }
-  if (!closed[1]) return {};
-  std::vector<int> sequence;
-  for (int v = 1; v >= 0; v = parent[v]) sequence.push_back(v);
-  std::reverse(sequence.begin(), sequence.end());
-  return sequence;
+  return sequence_to_goal(closed, parent);
 }
 
 std::vector<Vec3> interpolate(const std::vector<Vec3>& waypoints, double spacing) {

@@ -85,8 +85,8 @@ std::vector<ObstacleBox> boxes_from(const cuboid_list_t& msg) {
   return boxes;
 }
 
-global_path_t path_message(const PlanResult& result, Utime utime,
-                           const PlanResult* geometric_route, const PlanResult* backtrack_route) {
+global_path_t path_message(const PlanResult& result, Utime utime, const PlanResult* geometric_route,
+                           const PlanResult* backtrack_route) {
   global_path_t m;
   m.utime = utime;
   m.frame = "NED";
@@ -199,9 +199,8 @@ void GlobalPlannerService::replan(const char* why) {
   else if (status_changed)
     node_.log().info("route found ({}): {:.1f} m over {} nodes, {} cuboids", why, result.cost,
                      result.waypoints.size(), request.obstacles.size());
-  node_.publish(channels::kGlobalPath,
-                path_message(result, now, geometric ? &*geometric : nullptr,
-                             backtrack ? &*backtrack : nullptr));
+  node_.publish(channels::kGlobalPath, path_message(result, now, geometric ? &*geometric : nullptr,
+                                                    backtrack ? &*backtrack : nullptr));
   node_.set_state(to_string(result.status));
   last_plan_ = std::move(result);
 }

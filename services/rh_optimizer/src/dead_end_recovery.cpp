@@ -121,8 +121,7 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
   after_turn_ = RecoveryPhase::kEscaping;
   std::ostringstream why;
   why << "the route does not head along the leg from here: escaping along it, next to ("
-      << point.x() << ", "
-      << point.y() << ", " << point.z() << ") m, "
+      << point.x() << ", " << point.y() << ", " << point.z() << ") m, "
       << (point - in.position).norm() << " m away";
   enter(RecoveryPhase::kTurning, why.str());
   return true;
@@ -152,8 +151,8 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
     look_start_ = in.time;
     look_end_.reset();
     std::ostringstream text;
-    text << why << ": hovering, looking around (" << attempts_ << " of "
-         << settings_.max_attempts << ")";
+    text << why << ": hovering, looking around (" << attempts_ << " of " << settings_.max_attempts
+         << ")";
     enter(RecoveryPhase::kLooking, text.str());
   };
 

@@ -369,8 +369,7 @@ SolveReport RhOptimizer::solve(const RhProblem& problem, const InitialGuess& gue
   } else if (!report.feasible) {
     // Which rule the least violating point breaks most: what a user reading
     // the log needs to know (the clearance, the terminal x, a limit).
-    message << " (worst: " << check(problem, report.trajectory, kReportSamples).worst_name()
-            << ")";
+    message << " (worst: " << check(problem, report.trajectory, kReportSamples).worst_name() << ")";
   }
   return finish(message.str());
 }

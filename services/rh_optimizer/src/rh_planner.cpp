@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace ofn::rh {
@@ -104,6 +105,28 @@ double RhPlanner::braking_window(const RhProblem& problem) const {
   return stop_time + fallback_.keep_min_remaining;
 }
 
+namespace {
+
+struct Conflict {
+  double time = 0;       // s on the plan
+  double clearance = 0;  // m there
+};
+
+/// The first point of `plan` over [from, from + span], sampled every
+/// kKeepCheckStep, that comes within limits.clearance of an obstacle.
+std::optional<Conflict> first_conflict(const BsplineTrajectory& plan, double from, double span,
+                                       const RhProblem& problem) {
+  const int samples = std::max(2, static_cast<int>(std::ceil(span / kKeepCheckStep)));
+  for (int k = 0; k <= samples; ++k) {
+    const double t = from + span * k / samples;
+    const double clearance = problem.clearance(plan.position(t)).distance;
+    if (!(clearance >= problem.limits.clearance)) return Conflict{t, clearance};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 StepOutput RhPlanner::step(const StepInput& input) {
   StepOutput out;
   const RhProblem& problem = input.problem;
@@ -167,7 +190,7 @@ StepOutput RhPlanner::step(const StepInput& input) {
     accepted = committable(out.report);
   }
   if (accepted && guess.warm && fallback_.stall_retry &&
-             plan_stalled(out.report.trajectory, problem)) {
+      plan_stalled(out.report.trajectory, problem)) {
     SolveReport cold = optimizer_.solve(problem, cold_guess());
     out.solves = 2;
     out.stalled = true;
@@ -246,16 +269,11 @@ StepOutput RhPlanner::step(const StepInput& input) {
     // new cuboid grazing the far end of the horizon then costs a replan, not
     // a stop at cruise speed.
     const double checked = std::min(remaining, braking_window(problem));
-    const int samples = std::max(2, static_cast<int>(std::ceil(checked / kKeepCheckStep)));
-    for (int k = 0; k <= samples; ++k) {
-      const double t = elapsed + checked * k / samples;
-      const double clearance = problem.clearance(previous_.position(t)).distance;
-      if (!(clearance >= problem.limits.clearance)) {
-        std::ostringstream why;
-        why << failure << "; previous comes within " << clearance << " m of an obstacle at " << t
-            << " s";
-        return nearer_or_brake(why.str());
-      }
+    if (const auto conflict = first_conflict(previous_, elapsed, checked, problem)) {
+      std::ostringstream why;
+      why << failure << "; previous comes within " << conflict->clearance << " m of an obstacle at "
+          << conflict->time << " s";
+      return nearer_or_brake(why.str());
     }
   }
   // The kept plan must still start on the state flown now and carry a safe
@@ -269,17 +287,12 @@ StepOutput RhPlanner::step(const StepInput& input) {
     // Beyond the braking window: is the kept plan clear to its end?
     const double from = elapsed + std::min(remaining, braking_window(problem));
     const double rest = previous_.duration() - from;
-    const int samples = std::max(2, static_cast<int>(std::ceil(rest / kKeepCheckStep)));
-    for (int k = 0; k <= samples && rest > 0; ++k) {
-      const double t = from + rest * k / samples;
-      const double clearance = problem.clearance(previous_.position(t)).distance;
-      if (!(clearance >= problem.limits.clearance)) {
-        std::ostringstream why;
-        why << failure << "; previous comes within " << clearance << " m of an obstacle at " << t
-            << " s, beyond the braking window";
-        if (nearer(why.str())) return out;
-        break;
-      }
+    if (const auto conflict =
+            rest > 0 ? first_conflict(previous_, from, rest, problem) : std::nullopt) {
+      std::ostringstream why;
+      why << failure << "; previous comes within " << conflict->clearance << " m of an obstacle at "
+          << conflict->time << " s, beyond the braking window";
+      if (nearer(why.str())) return out;
     }
   }
   out.commit = kept;

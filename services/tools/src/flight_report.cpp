@@ -428,7 +428,8 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
       << solver_status_count[solver_stats_t::DEFERRED] << ", looking around "
       << solver_status_count[solver_stats_t::LOOKING_AROUND] << ", no route "
       << solver_status_count[solver_stats_t::NO_ROUTE] << "; " << std::setprecision(1)
-      << s.recovery_time << " s in dead-end recovery\n" << std::setprecision(2);
+      << s.recovery_time << " s in dead-end recovery\n"
+      << std::setprecision(2);
   } else {
     t << "  RH optimiser      : never engaged (nominal waypoint guidance throughout)\n";
   }

@@ -94,9 +94,9 @@ class Mapper {
     int row, col;
     float seen_top;  // the top a beam went over, where the surface was found
   };
-  std::vector<uint8_t> top_known_;   // scratch, per raw cell
-  std::vector<KnownTop> frontier_;   // scratch
-  ObstacleGrid confirmed_;  // scratch: the grid's confirmed cells, inflated and smoothed
+  std::vector<uint8_t> top_known_;  // scratch, per raw cell
+  std::vector<KnownTop> frontier_;  // scratch
+  ObstacleGrid confirmed_;          // scratch: the grid's confirmed cells, inflated and smoothed
   // Per cell, the highest top a beam has been seen to pass over (same
   // geometry as grid_, moved with it).
   ObstacleGrid seen_over_;

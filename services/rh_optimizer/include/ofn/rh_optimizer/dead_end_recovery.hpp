@@ -35,16 +35,17 @@ namespace ofn::rh {
 
 struct RecoverySettings {
   bool enabled = true;
-  double stuck_time = 4.0;       // s hovering without a moving plan before the look-around
-  double hover_speed = 0.3;      // m/s below which the vehicle counts as hovering
-  double look_turn = 6.2832;     // rad of heading the look-around turns through (a full turn)
-  double look_timeout = 40.0;    // s; the look ends then, turned through or not
-  double route_wait = 3.0;       // s after the look for the map and the route to take it in
-  double route_timeout = 10.0;   // s after the look without a newer route: no route
-  double capture_radius = 3.0;   // m from the escape point at which the escape is done
-  double face_tolerance = 0.26;  // rad; an escape leg starts once the heading is this near its direction
-  double face_hold = 1.0;        // s facing the leg before it starts (the scanner clears its shadows)
-  int max_attempts = 3;          // looks in a row with no escape leg done between: then "no route" for good
+  double stuck_time = 4.0;      // s hovering without a moving plan before the look-around
+  double hover_speed = 0.3;     // m/s below which the vehicle counts as hovering
+  double look_turn = 6.2832;    // rad of heading the look-around turns through (a full turn)
+  double look_timeout = 40.0;   // s; the look ends then, turned through or not
+  double route_wait = 3.0;      // s after the look for the map and the route to take it in
+  double route_timeout = 10.0;  // s after the look without a newer route: no route
+  double capture_radius = 3.0;  // m from the escape point at which the escape is done
+  double face_tolerance =
+      0.26;                // rad; an escape leg starts once the heading is this near its direction
+  double face_hold = 1.0;  // s facing the leg before it starts (the scanner clears its shadows)
+  int max_attempts = 3;  // looks in a row with no escape leg done between: then "no route" for good
 };
 
 enum class RecoveryPhase { kIdle, kLooking, kTurning, kEscaping, kNoRoute };
@@ -59,14 +60,14 @@ struct RecoveryInput {
   double time = 0;  // s
   Vec3 position = Vec3::Zero();
   Vec3 velocity = Vec3::Zero();
-  double yaw = 0;             // rad, the vehicle's heading
-  bool engaged = false;       // avoidance engaged (false: guidance flies the leg)
-  bool moving_plan = false;   // the last step committed a solved plan that moves off
+  double yaw = 0;            // rad, the vehicle's heading
+  bool engaged = false;      // avoidance engaged (false: guidance flies the leg)
+  bool moving_plan = false;  // the last step committed a solved plan that moves off
   RouteKind route = RouteKind::kNone;
-  double route_time = -1e300;            // s, when that route was made
+  double route_time = -1e300;  // s, when that route was made
   // world NED, vehicle first: the route's points, whatever its kind
   const std::vector<Vec3>* route_points = nullptr;
-  GuidanceFrame leg;                     // the mission leg's frame
+  GuidanceFrame leg;  // the mission leg's frame
 };
 
 struct RecoveryDecision {
@@ -129,7 +130,7 @@ class DeadEndRecovery {
   double look_start_ = 0;
   std::optional<double> look_end_;
   std::optional<double> facing_since_;
-  double face_yaw_ = 0;                           // rad, where kTurning turns to
+  double face_yaw_ = 0;                              // rad, where kTurning turns to
   RecoveryPhase after_turn_ = RecoveryPhase::kIdle;  // what follows kTurning
   int attempts_ = 0;
 };
