@@ -12,7 +12,7 @@ const char* to_string(RecoveryPhase phase) {
     case RecoveryPhase::kLooking:
       return "looking around";
     case RecoveryPhase::kTurning:
-      return "turning to the escape leg";
+      return "turning to the way on";
     case RecoveryPhase::kEscaping:
       return "escaping";
     case RecoveryPhase::kNoRoute:
@@ -80,6 +80,21 @@ void DeadEndRecovery::enter(RecoveryPhase phase, std::string reason) {
   stuck_since_.reset();
 }
 
+void DeadEndRecovery::begin_turn(const RecoveryInput& in) {
+  turned_ = 0;
+  last_yaw_ = in.yaw;
+  look_start_ = in.time;
+  look_end_.reset();
+  facing_since_.reset();
+}
+
+bool DeadEndRecovery::turned_through(const RecoveryInput& in) {
+  turned_ += wrap_angle(in.yaw - last_yaw_);
+  last_yaw_ = in.yaw;
+  return std::abs(turned_) >= settings_.look_turn ||
+         in.time - look_start_ >= settings_.look_timeout;
+}
+
 bool DeadEndRecovery::stuck(const RecoveryInput& in) {
   if (in.moving_plan || !(in.velocity.norm() < settings_.hover_speed)) {
     stuck_since_.reset();
@@ -98,10 +113,7 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
   const std::vector<Vec3> none;
   const std::vector<Vec3>& route = in.route_points ? *in.route_points : none;
   const auto k = escape_leg_end(route, in.leg, settings_.capture_radius);
-  turned_ = 0;
-  last_yaw_ = in.yaw;
-  look_start_ = in.time;
-  facing_since_.reset();
+  begin_turn(in);
   if (!k || (route[*k] - in.position).norm() <= settings_.capture_radius) {
     // Normal planning, once the scanner looks along the leg: a vehicle left
     // facing the way it came sees nothing ahead, and the commit gate lets
@@ -146,10 +158,7 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       return;
     }
     ++attempts_;
-    turned_ = 0;
-    last_yaw_ = in.yaw;
-    look_start_ = in.time;
-    look_end_.reset();
+    begin_turn(in);
     std::ostringstream text;
     text << why << ": hovering, looking around (" << attempts_ << " of " << settings_.max_attempts
          << ")";
@@ -162,11 +171,7 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       break;
     case RecoveryPhase::kLooking:
       if (!look_end_) {
-        turned_ += wrap_angle(in.yaw - last_yaw_);
-        last_yaw_ = in.yaw;
-        if (std::abs(turned_) >= settings_.look_turn ||
-            in.time - look_start_ >= settings_.look_timeout)
-          look_end_ = in.time;
+        if (turned_through(in)) look_end_ = in.time;
       } else if (in.time - *look_end_ >= settings_.route_wait && in.route_time >= *look_end_) {
         if (!take_route(in))
           enter(RecoveryPhase::kNoRoute, "no route after the look-around: holding the hover");
@@ -178,13 +183,11 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       // The controller turns the heading one way at its rate; what follows
       // starts once it faces the way it will fly (or after a full turn,
       // whatever it faces then: the map has been swept all round).
-      turned_ += wrap_angle(in.yaw - last_yaw_);
-      last_yaw_ = in.yaw;
+      const bool turned = turned_through(in);
       const bool facing = std::abs(wrap_angle(in.yaw - face_yaw_)) <= settings_.face_tolerance;
       if (facing && !facing_since_) facing_since_ = in.time;
-      const bool done = (facing_since_ && in.time - *facing_since_ >= settings_.face_hold) ||
-                        std::abs(turned_) >= settings_.look_turn ||
-                        in.time - look_start_ >= settings_.look_timeout;
+      const bool done =
+          (facing_since_ && in.time - *facing_since_ >= settings_.face_hold) || turned;
       if (done && after_turn_ == RecoveryPhase::kEscaping) {
         enter(RecoveryPhase::kEscaping, "facing the escape leg: flying it");
         decision_.escape_from = in.position;

@@ -118,6 +118,11 @@ class DeadEndRecovery {
  private:
   void enter(RecoveryPhase phase, std::string reason);
   bool stuck(const RecoveryInput& in);
+  /// Starts counting the heading turned (a look, or a turn to face the way on).
+  void begin_turn(const RecoveryInput& in);
+  /// Adds the heading turned since the last update; true after a full turn
+  /// or the look's timeout.
+  bool turned_through(const RecoveryInput& in);
   /// Takes up the route of `in` if it leads anywhere: normal planning or
   /// an escape. Returns false when there is none.
   bool take_route(const RecoveryInput& in);
