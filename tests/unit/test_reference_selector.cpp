@@ -57,15 +57,17 @@ TEST(ReferenceSelector, AStalePlanIsFollowedByItsStopAndAHover) {
   EXPECT_LT((first.velocity - flown.velocity).norm(), 1e-12);
   EXPECT_NEAR(first.acceleration.x(), -0.8 * max_accel, 1e-12);
   // The stop is fixed at its start: later calls ignore the reference passed.
-  const double stop_time = 3.0 / (0.8 * max_accel);
-  const Reference end =
-      selector.safe_stop(100.0 + stop_time + 5.0, at(Vec3::Zero(), Vec3::Zero()), max_accel);
-  EXPECT_NEAR(end.position.x(), 10.0 + 0.5 * 3.0 * stop_time, 1e-9);
+  // It is braking.hpp's: constant deceleration, then the ease-out.
+  const StopProfile expected = stop_from(flown.position, flown.velocity, 0.8 * max_accel);
+  const Reference end = selector.safe_stop(100.0 + expected.stop_time + 5.0,
+                                           at(Vec3::Zero(), Vec3::Zero()), max_accel);
+  EXPECT_NEAR(end.position.x(), expected.stop_point().x(), 1e-9);
+  EXPECT_GT(end.position.x(), 10.0 + 3.0 * 3.0 / (2 * 0.8 * max_accel));
   EXPECT_LT(end.velocity.norm(), 1e-12);
   EXPECT_LT(end.acceleration.norm(), 1e-12);
-  // Half way, half the speed.
-  const Reference mid = selector.safe_stop(100.0 + 0.5 * stop_time, flown, max_accel);
-  EXPECT_NEAR(mid.velocity.x(), 1.5, 1e-9);
+  // A second in, a second's deceleration off the speed.
+  const Reference mid = selector.safe_stop(101.0, flown, max_accel);
+  EXPECT_NEAR(mid.velocity.x(), 3.0 - 0.8 * max_accel, 1e-9);
   // A fresh plan ends the stop; the hand-back ends the avoidance.
   selector.plan_flown();
   EXPECT_FALSE(selector.stopping());
@@ -81,7 +83,9 @@ TEST(ReferenceSelector, TheHoldBeforeAMissionBrakesFromTheVehiclesState) {
   EXPECT_LT((first.velocity - Vec3(3, 0, 0)).norm(), 1e-12);
   EXPECT_NEAR(first.acceleration.norm(), 0.4, 1e-12);
   const Reference later = selector.hold(20.0, Vec3(99, 0, 0), Vec3::Zero(), false);
-  EXPECT_NEAR(later.position.x(), 0.5 * 3.0 * 3.0 / 0.4, 1e-9);
+  // v^2 / (2 a), and a tau^2 / 24 for the ease-out.
+  EXPECT_NEAR(later.position.x(), 0.5 * 3.0 * 3.0 / 0.4 + 0.4 * kStopRampTime * kStopRampTime / 24,
+              1e-9);
   EXPECT_LT(later.velocity.norm(), 1e-12);
 }
 

@@ -242,9 +242,10 @@ TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
     input.problem.velocity = first.trajectory.velocity(0.2);
     return std::make_pair(planner.braking_window(input.problem), planner.step(input));
   };
-  // 9.8 s: braking from 3.048 m/s at 0.8 of 0.4877 m/s^2, plus the 2 s kept.
+  // 10.2 s: braking from 3.048 m/s at 0.8 of 0.4877 m/s^2 with its 0.8 s
+  // ease-out, plus the 2 s kept.
   const auto [window, far] = fail_against_wall_at(55.0);
-  EXPECT_NEAR(window, 3.048 / (0.8 * 0.4877) + 2.0, 1e-9);
+  EXPECT_NEAR(window, 3.048 / (0.8 * 0.4877) + 0.5 * kStopRampTime + 2.0, 1e-9);
   EXPECT_EQ(far.mode, StepMode::kKeptPrevious) << far.reason;
   EXPECT_DOUBLE_EQ(far.start_time, 0.0);
   // The same wall 30 m ahead, met 7.6 s on, inside the window: brake now.
@@ -280,7 +281,8 @@ TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
   const FallbackSettings fallback;
   const RhPlanner planner(RhSettings{}, fallback);
   const double limit = fallback.braking_accel_fraction * kLimits.max_accel;
-  for (const Vec3& velocity : {Vec3(3.0, 0, 0), Vec3(1.5, -2.0, 0.8), Vec3(0, 0, 0)}) {
+  for (const Vec3& velocity :
+       {Vec3(3.0, 0, 0), Vec3(1.5, -2.0, 0.8), Vec3(0.05, 0.02, 0), Vec3(0, 0, 0)}) {
     RhProblem problem;
     problem.position = Vec3(10, -4, -25);
     problem.velocity = velocity;
@@ -293,18 +295,22 @@ TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
     const double T = braking.duration();
     EXPECT_LT(braking.velocity(T).norm(), 1e-9);
     EXPECT_LT(braking.velocity(T + 5.0).norm(), 1e-9);
+    // Exactly the stop of braking.hpp that the gate checks and the
+    // controller flies.
+    const StopProfile stop = stop_from(problem.position, velocity, limit);
     for (int k = 0; k <= 500; ++k) {
       const double t = T * k / 500.0;
       EXPECT_LE(braking.acceleration(t).norm(), limit + 1e-9) << "t " << t;
+      EXPECT_LT((braking.position(t) - stop.position(t)).norm(), 1e-9) << "t " << t;
+      EXPECT_LT((braking.velocity(t) - stop.velocity_at(t)).norm(), 1e-9) << "t " << t;
+      EXPECT_LT((braking.acceleration(t) - stop.acceleration_at(t)).norm(), 1e-8) << "t " << t;
       // Decelerating along the velocity: never turning or speeding up.
       if (velocity.norm() > 0) {
         EXPECT_GE(braking.velocity(t).dot(velocity), -1e-9);
         EXPECT_LE(braking.velocity(t).norm(), velocity.norm() + 1e-9);
       }
     }
-    // The stop lies v^2 / (2 a) along the velocity.
-    const Vec3 expected_stop = problem.position + velocity * (velocity.norm() / (2.0 * limit));
-    EXPECT_LT((braking.position(T) - expected_stop).norm(), 1e-9);
+    EXPECT_LT((braking.position(T) - stop.stop_point()).norm(), 1e-9);
   }
 }
 

@@ -612,7 +612,7 @@ void RhOptimizerService::tick() {
   // would only leave it hovering.
   if (out.mode == StepMode::kBraking && last_trajectory_.empty()) {
     const double brake = config_.fallback.braking_accel_fraction * limits.max_accel;
-    const double braking_distance = velocity.squaredNorm() / (2.0 * std::max(brake, 1e-6));
+    const double braking_distance = stop_from(Vec3::Zero(), velocity, brake).distance();
     if (nominal.conflict_distance > braking_distance + config_.defer_margin) {
       note("avoidance deferred: no trajectory yet");
       return publish_stats(now, solver_stats_t::DEFERRED,

@@ -1,6 +1,7 @@
 #include "ofn/rh_optimizer/rh_planner.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -73,21 +74,67 @@ void RhPlanner::reset() {
   previous_start_ = 0;
 }
 
+namespace {
+
+/// Cubic in t: c[0] + c[1] t + c[2] t^2 + c[3] t^3.
+using Cubic = std::array<double, 4>;
+
+/// The blossom (polar form) of a cubic: the symmetric multi-affine function
+/// whose diagonal is the cubic. A B-spline's control point is the blossom
+/// of any of its pieces at the knots the control point spans.
+double blossom(const Cubic& c, double u1, double u2, double u3) {
+  return c[0] + c[1] * (u1 + u2 + u3) / 3.0 + c[2] * (u1 * u2 + u1 * u3 + u2 * u3) / 3.0 +
+         c[3] * u1 * u2 * u3;
+}
+
+/// The distance along a stop as a cubic in t on the phase holding `t`.
+Cubic stop_piece(const StopProfile& stop, double t) {
+  const double v0 = stop.velocity.norm(), a = stop.peak_deceleration;
+  if (t < stop.constant_time) return {0.0, v0, -0.5 * a, 0.0};
+  if (t < stop.stop_time) {
+    // d1 + v1 u - a u^2 / 2 + a u^3 / (6 tau), u = t - t1, expanded in t.
+    const double t1 = stop.constant_time, tau = stop.ramp_time;
+    const double d1 = stop.distance_at(t1), v1 = v0 - a * t1;
+    const double k2 = -0.5 * a, k3 = a / (6.0 * tau);
+    return {d1 - v1 * t1 + k2 * t1 * t1 - k3 * t1 * t1 * t1, v1 - 2 * k2 * t1 + 3 * k3 * t1 * t1,
+            k2 - 3 * k3 * t1, k3};
+  }
+  return {stop.distance(), 0.0, 0.0, 0.0};
+}
+
+}  // namespace
+
 BsplineTrajectory RhPlanner::braking_trajectory(const RhProblem& problem) const {
   // The stop of braking.hpp (the one the commit gate checks and the
-  // controller flies) as a quadratic B-spline: its first knot interval is
-  // the deceleration, a parabola from the state to the stop point, and its
-  // second the hover.
+  // controller flies) as a cubic B-spline, exactly: its pieces (constant
+  // deceleration, ease-out, hover) are cubics joined with continuous
+  // acceleration, so a knot at each join holds them all.
   const Vec3 position = problem.position.allFinite() ? problem.position : Vec3::Zero();
   const Vec3 velocity = problem.velocity.allFinite() ? problem.velocity : Vec3::Zero();
   const StopProfile stop = stop_from(position, velocity, braking_decel(problem));
   const double hold = std::max(kMinHold, stop.stop_time);
   const double duration = stop.stop_time + hold;
-  const Vec3 end = stop.stop_point();
+  std::vector<double> knots(4, 0.0);  // s, then normalised
+  // A constant part too short to matter gets no knot (the ease-out's cubic
+  // stands in for it, off by far less than a millimetre).
+  if (stop.constant_time > 1e-6 * duration) knots.push_back(stop.constant_time);
   // A hover needs no deceleration piece; any interior knot gives the same
   // constant trajectory.
-  const double knot = stop.stop_time > 0 ? stop.stop_time / duration : 0.5;
-  return BsplineTrajectory(2, {0, 0, 0, knot, 1, 1, 1}, {position, end, end, end}, duration);
+  knots.push_back(stop.stop_time > 0 ? stop.stop_time : 0.5 * duration);
+  knots.insert(knots.end(), 4, duration);
+  const Vec3 direction = stop.direction();
+  std::vector<Vec3> control_points;
+  for (std::size_t i = 0; i + 4 < knots.size(); ++i) {
+    // Any piece under the control point's support gives the same blossom;
+    // take the first non-empty knot interval's.
+    std::size_t j = i;
+    while (j < i + 3 && !(knots[j + 1] > knots[j])) ++j;
+    const Cubic piece = stop_piece(stop, 0.5 * (knots[j] + knots[j + 1]));
+    control_points.push_back(position +
+                             direction * blossom(piece, knots[i + 1], knots[i + 2], knots[i + 3]));
+  }
+  for (double& k : knots) k /= duration;
+  return BsplineTrajectory(3, std::move(knots), std::move(control_points), duration);
 }
 
 double RhPlanner::braking_decel(const RhProblem& problem) const {
@@ -101,7 +148,10 @@ double RhPlanner::braking_window(const RhProblem& problem) const {
   // under a second of braking on the benchmarks' limits, inside the
   // keep_min_remaining added.
   const double speed = std::max(problem.velocity.norm(), problem.limits.max_speed);
-  const double stop_time = std::isfinite(speed) ? speed / braking_decel(problem) : 0.0;
+  const double stop_time =
+      std::isfinite(speed)
+          ? stop_from(Vec3::Zero(), Vec3(speed, 0.0, 0.0), braking_decel(problem)).stop_time
+          : 0.0;
   return stop_time + fallback_.keep_min_remaining;
 }
 
