@@ -13,7 +13,9 @@ add_custom_command(
   OUTPUT ${OFN_LCM_HEADERS}
   COMMAND ${CMAKE_COMMAND} -E make_directory ${OFN_LCM_OUT}/cpp
   COMMAND ${LCM_GEN} --cpp --cpp-std=c++11 --cpp-hpath ${OFN_LCM_OUT}/cpp ${OFN_LCM_FILES}
-  DEPENDS ${OFN_LCM_FILES}
+  COMMAND ${CMAKE_COMMAND} -DHEADER_DIR=${OFN_LCM_OUT}/cpp/ofn -P
+          ${CMAKE_SOURCE_DIR}/cmake/HardenLcmDecode.cmake
+  DEPENDS ${OFN_LCM_FILES} ${CMAKE_SOURCE_DIR}/cmake/HardenLcmDecode.cmake
   COMMENT "lcm-gen: C++ message headers"
   VERBATIM)
 add_custom_target(ofn_lcmtypes_cpp DEPENDS ${OFN_LCM_HEADERS})

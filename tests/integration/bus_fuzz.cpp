@@ -1,5 +1,7 @@
-// Publishes garbage on every channel of the bus (random bytes, and each
-// message type filled with NaN or with absurd sizes), then listens to the
+// Publishes garbage on every channel of the bus (random bytes, each message
+// type filled with NaN or with absurd sizes, and valid encodings with a
+// hostile int32 written over a random field: negative or huge array counts
+// and string lengths behind a valid fingerprint), then listens to the
 // heartbeats and reports each service's rejection counter. Exits 0 when
 // every service named on the command line is still alive and has rejected
 // something.
@@ -30,6 +32,22 @@
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// `m` encoded, with a hostile int32 (big-endian) written at a random
+/// 4-byte-aligned offset after the fingerprint: wherever it lands on an
+/// array count or a string length, the decoder must fail cleanly.
+template <class Msg>
+std::vector<uint8_t> with_hostile_int32(const Msg& m, std::mt19937& rng) {
+  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  static const int32_t kHostile[] = {-1, -2147483647 - 1, 0, 1 << 26, 2147483647};
+  if (bytes.size() < 12) return bytes;
+  const size_t slots = (bytes.size() - 8) / 4;
+  const size_t at = 8 + 4 * std::uniform_int_distribution<size_t>(0, slots - 1)(rng);
+  const auto value = static_cast<uint32_t>(kHostile[std::uniform_int_distribution<int>(0, 4)(rng)]);
+  for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<uint8_t>(value >> (24 - 8 * i));
+  return bytes;
+}
 
 void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string&,
                   std::map<std::string, ofn::heartbeat_t>* seen) {
@@ -95,6 +113,14 @@ int main(int argc, char** argv) {
     lcm.publish(ch::kMission, &mission);
     lcm.publish(ch::kRefTraj, &traj);
     lcm.publish(ch::kControlStatus, &status);
+    const auto hostile = [&](const std::string& channel, const auto& m) {
+      const std::vector<uint8_t> bytes = with_hostile_int32(m, rng);
+      lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    };
+    hostile(ch::kNavState, nav);
+    hostile(ch::kMission, mission);
+    hostile(ch::kRefTraj, traj);
+    hostile(ch::kControlStatus, status);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
     while (lcm.handleTimeout(0) > 0) {
     }

@@ -4,6 +4,7 @@
 // all times come from the Clock it is given.
 
 #include <chrono>
+#include <exception>
 #include <functional>
 #include <map>
 #include <memory>
@@ -62,7 +63,16 @@ class Node {
     sub->deliver = [this, handler = std::move(handler), options,
                     channel](const lcm::ReceiveBuffer* rbuf) {
       Msg msg;
-      if (msg.decode(rbuf->data, 0, rbuf->data_size) != static_cast<int>(rbuf->data_size)) {
+      // The generated decoders bound counts and lengths by the bytes left
+      // (cmake/HardenLcmDecode.cmake); anything they still throw is one bad
+      // message, not a reason for the service to die.
+      int decoded = -1;
+      try {
+        decoded = msg.decode(rbuf->data, 0, rbuf->data_size);
+      } catch (const std::exception&) {
+        decoded = -1;
+      }
+      if (decoded != static_cast<int>(rbuf->data_size)) {
         reject(channel, "undecodable (" + std::to_string(rbuf->data_size) + " bytes)");
         return;
       }
