@@ -4,8 +4,19 @@
 Reads the process table (deploy/processes.yaml), starts lcm-logger and then
 every selected service in table order, pins each to its host's CPU core,
 restarts crashed services with exponential backoff, and stops everything
-cleanly when the run ends (ends_run process exits, --timeout, Ctrl-C or
-SIGTERM).
+cleanly when the run ends (ends_run process exits, a service exits with
+code 2, --timeout, Ctrl-C or SIGTERM).
+
+Before anything starts, the process table, the scenario and every selected
+service's config file are read and parsed as YAML, the command placeholders
+are filled in and the executables looked up; the first problem found is
+reported in one line and nothing is started.
+
+A service that exits with code 2 reports a configuration or usage error
+(services/common/src/service_main.cpp, guarded_main): restarting it cannot
+help, so the launcher ends the run at once instead.  Other exits of a
+restart: true service are restarted up to --max-restarts times in a row;
+a service that then runs --healthy-after seconds gets its budget back.
 
 Each service's output goes to the terminal prefixed with [name] and to
 <log_dir>/<flight-stem>/<name>.log; the LCM traffic goes to
@@ -13,12 +24,14 @@ Each service's output goes to the terminal prefixed with [name] and to
 <log_dir>/latest_log.
 
 Exit codes: the ends_run process's exit code when it ends the run; 2 for bad
-input (table, arguments, missing executables); 3 when --timeout ends the run;
-128+N when stopped by signal N; 1 when the launcher could not run (e.g.
-lcm-logger failed) or every service stopped without an ends_run process.
+input (arguments, table, scenario or config files, missing executables) and
+when a service exits with code 2; 3 when --timeout ends the run; 128+N when
+stopped by signal N; 1 when the launcher could not run (e.g. lcm-logger
+failed) or every service stopped without an ends_run process.
 
 Only the Python standard library and PyYAML are used so that the launcher
-runs unchanged on the onboard computers (Debian: python3-yaml).
+runs unchanged on the onboard computers (Debian: python3-yaml).  PyYAML is
+imported when first needed, so --help and --version work without it.
 """
 
 import argparse
@@ -33,12 +46,6 @@ import sys
 import threading
 import time
 
-try:
-    import yaml
-except ImportError:  # pragma: no cover - depends on the host
-    sys.stderr.write("launch.py: PyYAML is missing: apt-get install python3-yaml\n")
-    sys.exit(2)
-
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_TABLE = os.path.join(REPO_ROOT, "deploy", "processes.yaml")
 DEFAULT_BIN = os.path.join(REPO_ROOT, "build", "bin")
@@ -48,6 +55,14 @@ FALLBACK_LCM_URL = "udpm://239.255.76.67:7667?ttl=0"
 EXIT_BAD_INPUT = 2
 EXIT_TIMEOUT = 3
 EXIT_LAUNCHER_FAILURE = 1
+# What a service returns for a configuration or usage error (guarded_main in
+# services/common/src/service_main.cpp).  The same input fails the same way
+# on every restart, so such an exit is never restarted: it ends the run.
+EXIT_SERVICE_CONFIG_ERROR = 2
+
+# A service that has run this long since its last restart is healthy again:
+# its restart count starts over (--healthy-after).
+DEFAULT_HEALTHY_AFTER_S = 30.0
 
 # Restart backoff: 0.5 s, 1 s, 2 s, 4 s, 8 s, 8 s, ...  Short enough that a
 # flaky service is back quickly, long enough that a service crashing at
@@ -69,6 +84,9 @@ LOGGER_SETTLE_S = 0.5
 POLL_INTERVAL_S = 0.05
 
 PLACEHOLDERS = ("bin", "scenario", "rtf", "lcm_url", "timeout", "log_dir")
+# The option that sets each placeholder, for error messages.
+PLACEHOLDER_OPTIONS = {"bin": "--bin", "scenario": "--scenario", "rtf": "--rtf",
+                       "lcm_url": "--lcm-url", "timeout": "--timeout", "log_dir": "--log-dir"}
 # "{name}" but not "${name}", so shell snippets in commands keep working.
 PLACEHOLDER_RE = re.compile(r"(?<!\$)\{([A-Za-z_][A-Za-z0-9_]*)\}")
 NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
@@ -79,6 +97,36 @@ OPTIONAL_FIELDS = {"config": str, "restart": bool, "ends_run": bool, "priority":
 
 class TableError(Exception):
     """Invalid process table or launch input; reported with exit code 2."""
+
+
+def project_version():
+    """The project's version: project(... VERSION x.y.z) in the top-level
+    CMakeLists.txt, the one place it is defined."""
+    try:
+        with open(os.path.join(REPO_ROOT, "CMakeLists.txt"), encoding="utf-8") as f:
+            match = re.search(r"^\s*project\s*\([^)]*\bVERSION\s+([0-9][0-9A-Za-z.+-]*)", f.read(),
+                              re.MULTILINE | re.IGNORECASE)
+    except OSError:
+        match = None
+    return match.group(1) if match else "unknown"
+
+
+def _yaml():
+    """PyYAML, imported on first use."""
+    try:
+        import yaml
+    except ImportError:
+        raise TableError("PyYAML is missing: apt-get install python3-yaml")
+    return yaml
+
+
+def _yaml_error_text(error):
+    """One line for a YAMLError: 'line L, column C: problem'."""
+    mark = getattr(error, "problem_mark", None)
+    problem = getattr(error, "problem", None)
+    if mark is not None and problem:
+        return "line %d, column %d: %s" % (mark.line + 1, mark.column + 1, problem)
+    return " ".join(str(error).split())
 
 
 class ProcessSpec:
@@ -146,6 +194,7 @@ def load_table(path):
     by check_files() for the processes actually being started.
     """
     shown = _display_path(path)
+    yaml = _yaml()
     try:
         with open(path, "r", encoding="utf-8") as f:
             doc = yaml.safe_load(f)
@@ -153,8 +202,10 @@ def load_table(path):
         raise TableError("%s: process table not found" % shown)
     except OSError as e:
         raise TableError("%s: cannot read process table: %s" % (shown, e.strerror))
+    except UnicodeDecodeError:
+        raise TableError("%s: process table is not UTF-8 text" % shown)
     except yaml.YAMLError as e:
-        raise TableError("%s: not valid YAML: %s" % (shown, e))
+        raise TableError("%s: not valid YAML: %s" % (shown, _yaml_error_text(e)))
 
     if not isinstance(doc, dict):
         raise TableError("%s: top level must be a mapping with 'hosts' and 'processes'" % shown)
@@ -302,11 +353,45 @@ def resolve_executable(program):
     return shutil.which(program)
 
 
+def check_yaml_file(path, what, allow_empty):
+    """The file must be readable YAML whose top level is a mapping (or, with
+    allow_empty, nothing but comments).  `what` names it in the message, e.g.
+    "--scenario" or "<table>: process 'mapper': field 'config'"."""
+    yaml = _yaml()
+    if not os.path.exists(path):
+        raise TableError("%s: file %s not found" % (what, path))
+    if not os.path.isfile(path):
+        raise TableError("%s: %s is not a regular file" % (what, path))
+    try:
+        with open(path, "r", encoding="utf-8") as f:
+            doc = yaml.safe_load(f)
+    except OSError as e:
+        raise TableError("%s: cannot read %s: %s" % (what, path, e.strerror))
+    except UnicodeDecodeError:
+        raise TableError("%s: %s is not UTF-8 text" % (what, path))
+    except yaml.YAMLError as e:
+        raise TableError("%s: %s is not valid YAML: %s" % (what, path, _yaml_error_text(e)))
+    if doc is None and not allow_empty:
+        raise TableError("%s: %s is empty" % (what, path))
+    if doc is not None and not isinstance(doc, dict):
+        raise TableError("%s: %s: top level must be a mapping of fields, got %s"
+                         % (what, path, _type_name(type(doc))))
+
+
 def check_files(table, specs, values):
-    """Executables and config files of the selected processes must exist."""
+    """Everything the selected processes need, checked before any starts:
+    every placeholder has a value, the executables exist and the config
+    files are readable YAML."""
     shown = _display_path(table.path)
     for spec in specs:
         where = "%s: process '%s'" % (shown, spec.name)
+        for arg in spec.command:
+            for placeholder in PLACEHOLDER_RE.findall(arg):
+                if not values.get(placeholder):
+                    raise TableError("%s: field 'command': {%s} has no value (set it with %s)"
+                                     % (where, placeholder, PLACEHOLDER_OPTIONS[placeholder]))
+        if any("{bin}" in arg for arg in spec.command) and not os.path.isdir(values["bin"]):
+            raise TableError("--bin: directory %s not found - build first: make build" % values["bin"])
         argv = expand_command(spec, values)
         if resolve_executable(argv[0]) is None:
             if "/" in argv[0]:
@@ -318,8 +403,8 @@ def check_files(table, specs, values):
                                  % (where, path, hint))
             raise TableError("%s: field 'command': executable '%s' not found on PATH"
                              % (where, argv[0]))
-        if spec.config is not None and not os.path.isfile(spec.config):
-            raise TableError("%s: field 'config': file %s not found" % (where, spec.config))
+        if spec.config is not None:
+            check_yaml_file(spec.config, "%s: field 'config'" % where, allow_empty=True)
 
 
 # ---------------------------------------------------------------------------
@@ -462,7 +547,9 @@ class Child:
         self.reader = None
         self.state = Child.RUNNING
         self.starts = 0
-        self.restarts = 0
+        self.restarts = 0            # restarts in a row: counted against --max-restarts
+        self.total_restarts = 0      # restarts in the whole run
+        self.started_at = None       # monotonic time of the latest start
         self.restart_at = None       # monotonic time of a pending restart
         self.gave_up = False
         self.last_returncode = None
@@ -475,6 +562,7 @@ class Child:
         """Start the child; returns False if it could not be executed."""
         self.state = Child.RUNNING
         self.starts += 1
+        self.started_at = time.monotonic()
         log = open(self.log_path, "ab")
         stamp = datetime.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
         header = "=== launcher %s: start #%d: %s\n" % (stamp, self.starts, shlex.join(self.argv))
@@ -571,47 +659,75 @@ class RunState:
 # Command line and main
 # ---------------------------------------------------------------------------
 
-def parse_args(argv):
-    parser = argparse.ArgumentParser(
+class OneLineErrorParser(argparse.ArgumentParser):
+    """argparse whose usage errors are one line (exit code 2)."""
+
+    def error(self, message):
+        self.exit(EXIT_BAD_INPUT, "%s: error: %s (see --help)\n" % (self.prog, message))
+
+
+def build_parser():
+    parser = OneLineErrorParser(
         prog="deploy/launch.py",
         description="Start, supervise and record the flight-software services of one run.",
         epilog="Examples:\n"
-               "  deploy/launch.py --scenario scenarios/hover.yaml\n"
-               "  deploy/launch.py --scenario S --only mapper,global_planner --no-record --timeout 0\n"
+               "  deploy/launch.py --scenario sim/scenarios/bench3.yaml\n"
+               "  deploy/launch.py --scenario sim/scenarios/bench3.yaml --only mapper,global_planner \\\n"
+               "      --no-record --timeout 0\n"
                "      (re-run planners on a flight replayed with deploy/replay.sh)\n"
-               "  deploy/launch.py --scenario S --host onboard1 --timeout 0   (on the flight computer)",
+               "  deploy/launch.py --scenario sim/scenarios/bench3.yaml --host onboard1 --timeout 0\n"
+               "      (on the flight computer)\n"
+               "\n"
+               "Exit codes: the ends_run process's; 2 for bad input or a service that exits with\n"
+               "code 2 (its configuration or usage error; never restarted); 3 when --timeout\n"
+               "ends the run; 128+N on signal N; 1 when the launcher itself fails.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--table", default=DEFAULT_TABLE,
+    parser.add_argument("--version", action="version", version="%(prog)s " + project_version())
+    parser.add_argument("--table", default=DEFAULT_TABLE, metavar="FILE",
                         help="process table (default: deploy/processes.yaml)")
-    parser.add_argument("--scenario", required=True, help="scenario file, substituted for {scenario}")
-    parser.add_argument("--bin", default=DEFAULT_BIN,
+    parser.add_argument("--scenario", required=True, metavar="FILE",
+                        help="scenario file, substituted for {scenario} (required)")
+    parser.add_argument("--bin", default=DEFAULT_BIN, metavar="DIR",
                         help="directory of the service executables, {bin} (default: build/bin)")
-    parser.add_argument("--rtf", type=float, default=1.0,
+    parser.add_argument("--rtf", type=float, default=1.0, metavar="X",
                         help="simulation real-time factor, {rtf} (default: 1.0)")
-    parser.add_argument("--lcm-url", default=os.environ.get("LCM_DEFAULT_URL") or FALLBACK_LCM_URL,
+    parser.add_argument("--lcm-url", metavar="URL", default=os.environ.get("LCM_DEFAULT_URL") or FALLBACK_LCM_URL,
                         help="LCM URL, {lcm_url} (default: $LCM_DEFAULT_URL or %s)"
                              % FALLBACK_LCM_URL.replace("%", "%%"))
-    parser.add_argument("--log-dir", default=DEFAULT_LOG_DIR,
+    parser.add_argument("--log-dir", default=DEFAULT_LOG_DIR, metavar="DIR",
                         help="where flight logs and service logs go, {log_dir} (default: results/)")
-    parser.add_argument("--timeout", type=float, default=300.0,
+    parser.add_argument("--timeout", type=float, default=300.0, metavar="S",
                         help="overall wall-clock run limit in seconds, also {timeout}; "
                              "0 = no launcher limit, {timeout} then is 0 (default: 300)")
-    parser.add_argument("--no-pin", action="store_true", help="do not pin processes to cores")
-    parser.add_argument("--no-record", action="store_true", help="do not start lcm-logger")
+    parser.add_argument("--no-pin", action="store_true",
+                        help="do not pin processes to cores (default: pin them)")
+    parser.add_argument("--no-record", action="store_true",
+                        help="do not start lcm-logger (default: record the bus)")
     parser.add_argument("--only", metavar="NAME[,NAME]",
-                        help="start only these processes (comma-separated)")
-    parser.add_argument("--host", help="start only the processes of this host")
-    parser.add_argument("--max-restarts", type=int, default=5,
-                        help="restarts per service before giving up (default: 5)")
+                        help="start only these processes, comma-separated (default: all)")
+    parser.add_argument("--host", help="start only the processes of this host (default: all hosts)")
+    parser.add_argument("--max-restarts", type=int, default=5, metavar="N",
+                        help="restarts in a row per service before giving up (default: 5)")
+    parser.add_argument("--healthy-after", type=float, default=DEFAULT_HEALTHY_AFTER_S, metavar="S",
+                        help="a service that has run S seconds since its last restart gets its "
+                             "full --max-restarts budget back; 0 = never (default: %s)"
+                             % format_number(DEFAULT_HEALTHY_AFTER_S))
+    return parser
+
+
+def parse_args(argv):
+    parser = build_parser()
     args = parser.parse_args(argv)
 
     errors = []
     if not args.rtf > 0:
         errors.append("--rtf must be > 0")
-    if args.timeout < 0:
+    if not args.timeout >= 0:
         errors.append("--timeout must be >= 0")
     if args.max_restarts < 0:
         errors.append("--max-restarts must be >= 0")
+    if not args.healthy_after >= 0:
+        errors.append("--healthy-after must be >= 0")
     for message in errors:
         parser.error(message)  # exits with code 2
     args.only = [n.strip() for n in args.only.split(",") if n.strip()] if args.only else None
@@ -651,17 +767,17 @@ def main(argv=None):
         "log_dir": log_dir,
     }
 
+    # Everything is checked once, before anything starts.
     try:
         table = load_table(table_path)
         specs = select_processes(table, args.only, args.host)
-        if not os.path.isfile(scenario):
-            raise TableError("--scenario: file %s not found" % scenario)
+        check_yaml_file(scenario, "--scenario", allow_empty=False)
         check_files(table, specs, values)
         logger_exe = None
         if not args.no_record:
             logger_exe = shutil.which("lcm-logger")
             if logger_exe is None:
-                raise TableError("lcm-logger not found (apt-get install lcm), or pass --no-record")
+                raise TableError("lcm-logger not found (apt-get install liblcm-bin), or pass --no-record")
     except TableError as e:
         sys.stderr.write("launch.py: error: %s\n" % e)
         return EXIT_BAD_INPUT
@@ -758,6 +874,15 @@ def main(argv=None):
             note("not recording LCM traffic (--no-record)")
         say("service logs in %s/" % service_log_dir)
 
+        def reset_if_healthy(child, now):
+            """A service up --healthy-after seconds since its last restart gets
+            its restart budget back."""
+            if (child.restarts and args.healthy_after > 0 and child.started_at is not None
+                    and now - child.started_at >= args.healthy_after):
+                say("%s has run %s s since its last restart; restart count reset (0/%d)"
+                    % (child.name, format_number(args.healthy_after), args.max_restarts))
+                child.restarts = 0
+
         def handle_exit(child, now):
             """Decide what a child's exit means; returns (end_reason, exit_code) or None."""
             if child.proc is None:
@@ -766,6 +891,13 @@ def main(argv=None):
                 child.finish_output()
                 child.last_returncode = child.proc.returncode
                 code, text = describe_exit(child.proc.returncode)
+            if code == EXIT_SERVICE_CONFIG_ERROR:
+                # Restarting cannot fix a configuration or usage error, and
+                # the flight cannot go on without the service: stop now.
+                child.state = Child.DONE
+                return ("%s %s, a configuration or usage error (see its output above); "
+                        "not restarted: ending the run (exit code %d)"
+                        % (child.name, text, EXIT_BAD_INPUT)), EXIT_BAD_INPUT
             if child.spec.ends_run:
                 child.state = Child.DONE
                 return "%s %s; it ends the run" % (child.name, text), code
@@ -780,6 +912,7 @@ def main(argv=None):
                        args.max_restarts))
             else:
                 child.restarts += 1
+                child.total_restarts += 1
                 delay = min(BACKOFF_START_S * 2 ** (child.restarts - 1), BACKOFF_CAP_S)
                 child.state = Child.WAITING
                 child.restart_at = now + delay
@@ -813,6 +946,8 @@ def main(argv=None):
 
             for child in services:
                 outcome = None
+                if child.state == Child.RUNNING:
+                    reset_if_healthy(child, now)
                 if child.state == Child.RUNNING and not child.alive():
                     outcome = handle_exit(child, now)
                 elif child.state == Child.WAITING and now >= child.restart_at:
@@ -872,7 +1007,13 @@ def print_summary(services, console, max_restarts):
                 final += ", stopped by launcher"
             elif child.gave_up and child.spec.restart:
                 final += ", gave up"
-        restarts = "%d/%d" % (child.restarts, max_restarts) if child.spec.restart else "-"
+            elif code == EXIT_SERVICE_CONFIG_ERROR:
+                final += ", configuration or usage error"
+        restarts = "-"
+        if child.spec.restart:
+            restarts = "%d/%d" % (child.restarts, max_restarts)
+            if child.total_restarts != child.restarts:
+                restarts += " (%d in all)" % child.total_restarts
         rows.append((child.name, child.spec.host, restarts, final))
     width = max(len(r[0]) for r in rows)
     host_width = max(len(r[1]) for r in rows)

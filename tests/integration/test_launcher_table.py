@@ -1,4 +1,4 @@
-"""Tests of deploy/launch.py: table validation, core clamping, supervision.
+"""Tests of deploy/launch.py: table and input checks, core clamping, supervision.
 
 Needs no network and no LCM: every run uses --no-record and --no-pin and
 small shell commands in place of the flight services.
@@ -9,6 +9,7 @@ Run from the repository root:
 
 import importlib.util
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -39,7 +40,8 @@ class LauncherTestCase(unittest.TestCase):
         self.dir = self.tmp.name
         self.scenario = os.path.join(self.dir, "scenario.yaml")
         with open(self.scenario, "w") as f:
-            f.write("# dummy scenario\n")
+            f.write("# dummy scenario: the launcher only checks that it is a YAML mapping\n"
+                    "name: dummy\n")
         self.log_dir = os.path.join(self.dir, "results")
 
     def tearDown(self):
@@ -184,6 +186,146 @@ class TableValidationTest(LauncherTestCase):
                          ["worker"])
 
 
+class PreflightTest(LauncherTestCase):
+    """Scenario, config files, placeholders and executables are checked once,
+    before anything starts: one line on stderr, exit code 2, nothing run."""
+
+    def table_with_marker(self, config=None):
+        # The process leaves a marker file when it runs, so a test can tell
+        # that nothing was started.
+        self.marker = os.path.join(self.dir, "started")
+        return self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: worker
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "touch %s", "{scenario}", "{lcm_url}"]
+            %s""" % (self.marker, "    config: %s\n" % config if config else ""))
+
+    def assert_rejected(self, result, *fragments):
+        self.assertEqual(result.returncode, 2, result.stdout + result.stderr)
+        message = result.stderr.strip()
+        self.assertEqual(len(message.splitlines()), 1, "not one line: %r" % result.stderr)
+        self.assertTrue(message.startswith("launch.py: error: "), message)
+        for fragment in fragments:
+            self.assertIn(fragment, message)
+        self.assertFalse(os.path.exists(self.marker), "a process was started")
+        self.assertFalse(os.path.exists(self.log_dir), "the run was set up")
+
+    def write(self, name, text):
+        path = os.path.join(self.dir, name)
+        with open(path, "w") as f:
+            f.write(text)
+        return path
+
+    def test_scenario_that_is_not_yaml(self):
+        table = self.table_with_marker()
+        self.write("scenario.yaml", "name: broken\nobstacles: [1, 2\n")
+        self.assert_rejected(self.run_launcher(table), "--scenario", "scenario.yaml",
+                             "not valid YAML: line 3")
+
+    def test_scenario_that_is_empty_or_not_a_mapping(self):
+        table = self.table_with_marker()
+        self.write("scenario.yaml", "# nothing here\n")
+        self.assert_rejected(self.run_launcher(table), "scenario.yaml is empty")
+        self.write("scenario.yaml", "- 1\n- 2\n")
+        self.assert_rejected(self.run_launcher(table), "top level must be a mapping")
+
+    def test_scenario_that_is_missing_or_a_directory(self):
+        table = self.table_with_marker()
+        self.scenario = os.path.join(self.dir, "nope.yaml")
+        self.assert_rejected(self.run_launcher(table), "--scenario", "nope.yaml not found")
+        self.scenario = self.dir
+        self.assert_rejected(self.run_launcher(table), "--scenario", "not a regular file")
+
+    @unittest.skipIf(os.geteuid() == 0, "root reads any file")
+    def test_scenario_that_is_unreadable(self):
+        table = self.table_with_marker()
+        os.chmod(self.scenario, 0)
+        self.assert_rejected(self.run_launcher(table), "cannot read", "Permission denied")
+
+    def test_config_that_is_not_yaml(self):
+        config = self.write("worker.yaml", "rate_hz: 10\ngains: [1, 2\n")
+        table = self.table_with_marker(config)
+        self.assert_rejected(self.run_launcher(table), "process 'worker'", "field 'config'",
+                             "worker.yaml is not valid YAML: line 3")
+
+    def test_config_that_is_not_a_mapping(self):
+        table = self.table_with_marker(self.write("worker.yaml", "just a string\n"))
+        self.assert_rejected(self.run_launcher(table), "field 'config'",
+                             "top level must be a mapping of fields, got a string")
+
+    def test_config_of_comments_only_is_accepted(self):
+        table = self.table_with_marker(self.write("worker.yaml", "# all defaults\n"))
+        result = self.run_launcher(table, "--timeout", "30")
+        # The worker runs and exits 0; nothing else is left, so the run ends.
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertTrue(os.path.exists(self.marker))
+
+    def test_placeholder_without_value(self):
+        table = self.table_with_marker()
+        self.assert_rejected(self.run_launcher(table, "--lcm-url", ""),
+                             "process 'worker'", "{lcm_url} has no value", "--lcm-url")
+
+    def test_missing_bin_directory(self):
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: worker
+                host: gcs
+                core: 0
+                command: ["{bin}/ofn_worker"]
+            """)
+        self.marker = os.path.join(self.dir, "started")
+        self.assert_rejected(self.run_launcher(table, "--bin", os.path.join(self.dir, "no-build")),
+                             "--bin: directory", "no-build not found", "make build")
+
+    def test_missing_lcm_logger_names_the_debian_package(self):
+        table = self.table_with_marker()
+        empty = os.path.join(self.dir, "empty-path")
+        os.mkdir(empty)
+        cmd = [sys.executable, LAUNCHER, "--table", table, "--scenario", self.scenario,
+               "--log-dir", self.log_dir, "--no-pin"]
+        result = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                timeout=60, cwd=REPO_ROOT, env=dict(os.environ, PATH=empty))
+        self.assert_rejected(result, "lcm-logger not found", "apt-get install liblcm-bin",
+                             "--no-record")
+        self.assertNotIn("install lcm)", result.stderr)
+
+
+class CommandLineTest(LauncherTestCase):
+    def test_version_is_the_cmake_project_version(self):
+        with open(os.path.join(REPO_ROOT, "CMakeLists.txt")) as f:
+            version = re.search(r"project\([^)]*VERSION\s+([0-9.]+)", f.read()).group(1)
+        result = subprocess.run([sys.executable, LAUNCHER, "--version"], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, timeout=60)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(result.stdout.strip(), "deploy/launch.py " + version)
+
+    def test_usage_error_is_one_line(self):
+        for args in (["--scenario", self.scenario, "--rtf"], ["--scenario", self.scenario, "--bogus"],
+                     ["--scenario", self.scenario, "--healthy-after", "-1"], []):
+            result = subprocess.run([sys.executable, LAUNCHER] + args, stdout=subprocess.PIPE,
+                                    stderr=subprocess.PIPE, text=True, timeout=60)
+            self.assertEqual(result.returncode, 2, args)
+            self.assertEqual(len(result.stderr.strip().splitlines()), 1, result.stderr)
+
+    def test_help_shows_the_healthy_period_default_and_existing_examples(self):
+        result = subprocess.run([sys.executable, LAUNCHER, "--help"], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, timeout=60)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        text = " ".join(result.stdout.split())
+        self.assertRegex(text, r"--healthy-after S .*\(default: 30\)")
+        self.assertNotIn("hover.yaml", text)
+        examples = re.findall(r"--scenario (\S+\.yaml)", text)
+        self.assertTrue(examples)
+        for path in examples:
+            self.assertTrue(os.path.isfile(os.path.join(REPO_ROOT, path)), path)
+
+
 class CoreClampTest(unittest.TestCase):
     def test_clamps_to_last_core(self):
         ncpu = os.cpu_count()
@@ -305,6 +447,130 @@ class SupervisionTest(LauncherTestCase):
         self.assertNotIn("restarting", out)
         self.assertRegex(out, r"sleeper\s+gcs\s+restarts 0/5\s+.*stopped by launcher")
         self.assert_process_gone(pid_file)
+
+    def test_exit_code_2_is_not_restarted_and_ends_the_run(self):
+        # A configuration error fails the same way on every restart: the
+        # launcher must stop at once, not restart with backoff and then wait
+        # for the monitor (60 s here) or the run limit.
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: misconfigured
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "echo 'misconfigured: configuration error: bad field' >&2; exit 2"]
+                restart: true
+              - name: monitor
+                host: gcs
+                core: 0
+                command: ["sleep", "60"]
+                ends_run: true
+            """)
+        start = time.monotonic()
+        result = self.run_launcher(table, "--timeout", "120")
+        out = result.stdout
+        self.assertEqual(result.returncode, 2, out + result.stderr)
+        self.assertLess(time.monotonic() - start, 40, out)
+        self.assertNotIn("restarting", out)
+        lines = [l for l in out.splitlines() if "misconfigured exited with code 2" in l]
+        self.assertEqual(len(lines), 1, out)
+        self.assertIn("configuration or usage error", lines[0])
+        self.assertIn("not restarted: ending the run (exit code 2)", lines[0])
+        self.assertRegex(out, r"monitor\s+gcs\s+restarts -\s+.*stopped by launcher")
+        runs = [d for d in os.listdir(self.log_dir) if d.startswith("flight-")]
+        with open(os.path.join(self.log_dir, runs[0], "misconfigured.log")) as f:
+            self.assertEqual(f.read().count("=== launcher"), 1)
+
+    def test_exit_code_2_of_a_service_without_restart_ends_the_run(self):
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: oneshot
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "exit 2"]
+              - name: monitor
+                host: gcs
+                core: 0
+                command: ["sleep", "60"]
+                ends_run: true
+            """)
+        result = self.run_launcher(table, "--timeout", "120")
+        self.assertEqual(result.returncode, 2, result.stdout + result.stderr)
+        self.assertIn("oneshot exited with code 2, a configuration or usage error", result.stdout)
+
+    def test_other_exit_codes_are_still_restarted(self):
+        # Exit code 3 (or a signal) is an ordinary crash.
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: crasher
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "exit 3"]
+                restart: true
+            """)
+        result = self.run_launcher(table, "--max-restarts", "1", "--timeout", "60")
+        self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
+        self.assertIn("crasher exited with code 3; restarting in 0.5 s (restart 1/1)", result.stdout)
+        self.assertIn("GIVING UP after 1 restart", result.stdout)
+
+    def test_restart_count_resets_after_a_healthy_period(self):
+        # Starts 1, 2, 4 and 5 exit at once; start 3 runs 4 s, well past
+        # --healthy-after 1.5.  With --max-restarts 2 and no reset the
+        # launcher would give up when start 3 exits; with the reset, start 3
+        # earns the budget back and the launcher gives up only after start 5.
+        count_file = os.path.join(self.dir, "starts")
+        script = os.path.join(self.dir, "flaky.sh")
+        with open(script, "w") as f:
+            f.write(textwrap.dedent("""\
+                #!/bin/sh
+                n=$(cat %s 2>/dev/null || echo 0); n=$((n + 1)); echo $n > %s
+                echo "flaky start $n"
+                [ "$n" -eq 3 ] && sleep 4
+                exit 1
+                """ % (count_file, count_file)))
+        os.chmod(script, 0o755)
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: flaky
+                host: gcs
+                core: 0
+                command: ["%s"]
+                restart: true
+            """ % script)
+        result = self.run_launcher(table, "--max-restarts", "2", "--healthy-after", "1.5",
+                                   "--timeout", "100")
+        out = result.stdout
+        self.assertEqual(result.returncode, 1, out + result.stderr)
+        with open(count_file) as f:
+            self.assertEqual(f.read().strip(), "5", out)
+        self.assertIn("flaky has run 1.5 s since its last restart; restart count reset (0/2)", out)
+        restarts = re.findall(r"flaky exited with code 1; restarting in \S+ s \(restart (\d)/2\)", out)
+        self.assertEqual(restarts, ["1", "2", "1", "2"], out)
+        self.assertIn("GIVING UP after 2 restarts", out)
+        self.assertRegex(out, r"flaky\s+gcs\s+restarts 2/2 \(4 in all\)")
+
+    def test_healthy_after_0_keeps_the_budget_for_the_whole_run(self):
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: flaky
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "sleep 0.3; exit 1"]
+                restart: true
+            """)
+        result = self.run_launcher(table, "--max-restarts", "1", "--healthy-after", "0",
+                                   "--timeout", "60")
+        self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
+        self.assertNotIn("restart count reset", result.stdout)
 
     def assert_process_gone(self, pid_file):
         with open(pid_file) as f:
