@@ -274,6 +274,39 @@ TEST_F(NodeTest, ExplicitRejectIsCounted) {
   EXPECT_EQ(node.counters().rejected_by_reason.at("control: non-finite"), 2);
 }
 
+TEST_F(NodeTest, AFloodOfDistinctStaleStampsIsCountedUnderOneKind) {
+  // Every stale stamp gives a different reason text; counted by text, 60,000
+  // of them grew a service's memory for good.
+  SubscribeOptions options;
+  options.max_age = 0.2;
+  Node& node = subscribed(options);
+  for (int i = 0; i < 2000; ++i)
+    node.publish(kChannel, nav_at(clock_.now() - to_utime(1.0 + 0.001 * i)));
+  deliver();
+  EXPECT_EQ(node.counters().rejected, 2000);
+  ASSERT_EQ(node.counters().rejected_by_reason.size(), 1u);
+  EXPECT_EQ(node.counters().rejected_by_reason.begin()->first, "TEST_NAV: stale by # s");
+  EXPECT_EQ(node.counters().rejected_by_reason.begin()->second, 2000);
+  // The last reason keeps its numbers.
+  EXPECT_NE(node.counters().last_reject_reason.find("stale by 2.999"), std::string::npos)
+      << node.counters().last_reject_reason;
+}
+
+TEST_F(NodeTest, DistinctRejectKindsAreBounded) {
+  Node node("svc", lcm_, clock_);
+  for (int i = 0; i < 200; ++i)
+    node.reject("control", "kind " + std::string(1, 'a' + i % 26) + std::string(1, 'a' + i / 26));
+  EXPECT_EQ(node.counters().rejected_by_reason.size(), kMaxRejectKinds + 1);
+  EXPECT_EQ(node.counters().rejected_by_reason.at(kOtherRejectKind), 200 - 64);
+}
+
+TEST(RejectKind, NumbersBecomeOneMarkWordsStay) {
+  EXPECT_EQ(reject_kind("stale by 0.73 s"), "stale by # s");
+  EXPECT_EQ(reject_kind("speed -1.5e+03 against 10"), "speed # against #");
+  EXPECT_EQ(reject_kind("frame 'ENU' is not NED"), "frame 'ENU' is not NED");
+  EXPECT_EQ(reject_kind("see - here"), "see - here");
+}
+
 /// `bytes` with the big-endian int32 at `at` replaced by `value`.
 std::vector<uint8_t> with_int32(std::vector<uint8_t> bytes, size_t at, int32_t value) {
   const auto u = static_cast<uint32_t>(value);

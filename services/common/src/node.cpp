@@ -59,10 +59,44 @@ bool Node::check_time(const std::string& channel, Utime stamp, const SubscribeOp
   return true;
 }
 
+std::string reject_kind(const std::string& reason) {
+  // Every run of number characters that holds a digit becomes '#'.
+  static const std::string kNumberChars = "0123456789.+-eE";
+  std::string kind;
+  size_t i = 0;
+  while (i < reason.size()) {
+    size_t j = i;
+    bool digit = false;
+    while (j < reason.size() && kNumberChars.find(reason[j]) != std::string::npos) {
+      digit = digit || std::isdigit(static_cast<unsigned char>(reason[j]));
+      ++j;
+    }
+    if (j > i && digit) {
+      kind += '#';
+      i = j;
+    } else if (j > i) {
+      kind.append(reason, i, j - i);
+      i = j;
+    } else {
+      kind += reason[i++];
+    }
+  }
+  return kind;
+}
+
 void Node::reject(const std::string& channel, const std::string& reason) {
   ++counters_.rejected;
   counters_.last_reject_reason = channel + ": " + reason;
-  ++counters_.rejected_by_reason[counters_.last_reject_reason];
+  // Counted by kind, in a bounded table: a flood of distinct reasons (every
+  // stale stamp differs) must not grow the service's memory.
+  const std::string kind = reject_kind(counters_.last_reject_reason);
+  auto it = counters_.rejected_by_reason.find(kind);
+  if (it != counters_.rejected_by_reason.end())
+    ++it->second;
+  else if (counters_.rejected_by_reason.size() < kMaxRejectKinds)
+    counters_.rejected_by_reason.emplace(kind, 1);
+  else
+    ++counters_.rejected_by_reason[kOtherRejectKind];
   // One line per second at most, so a flood of bad input cannot flood the log.
   const Utime now = clock_.valid() ? clock_.now() : 0;
   if (last_reject_log_ == INT64_MIN || now - last_reject_log_ >= kMicrosPerSecond ||
@@ -121,6 +155,10 @@ void Node::fire_due_timers(Utime now, int max_catch_up) {
       ++fired;
     }
   }
+}
+
+void Node::restart_timers() {
+  for (auto& t : timers_) t.deadline = INT64_MIN;
 }
 
 void Node::account_work(std::chrono::steady_clock::duration busy) {

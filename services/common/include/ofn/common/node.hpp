@@ -19,12 +19,21 @@
 
 namespace ofn {
 
+/// Distinct rejection kinds counted one by one; the rest count as one.
+constexpr size_t kMaxRejectKinds = 64;
+constexpr const char* kOtherRejectKind = "(other kinds)";
+
+/// A rejection reason with its numbers replaced by '#' ("stale by 0.73 s"
+/// -> "stale by # s"): the key it is counted under.
+std::string reject_kind(const std::string& reason);
+
 /// Receipt and rejection counters reported in the heartbeat.
 struct NodeCounters {
   int64_t received = 0;
   int64_t rejected = 0;
   int64_t late = 0;
   std::string last_reject_reason;
+  /// By reject_kind of "channel: reason", at most kMaxRejectKinds + 1 entries.
   std::map<std::string, int64_t> rejected_by_reason;
 };
 
@@ -101,6 +110,10 @@ class Node {
   /// Runs every timer due at or before `now`. A timer that fell more than
   /// `max_catch_up` periods behind skips ahead and counts an overrun.
   void fire_due_timers(Utime now, int max_catch_up = 1000);
+  /// Schedules every timer afresh from the next clock tick, as at start: for
+  /// a clock that was deliberately set to another timeline (a restarted
+  /// simulation), where the old deadlines mean nothing.
+  void restart_timers();
 
   /// Counts and logs a rejected input; for checks a service makes itself.
   void reject(const std::string& channel, const std::string& reason);
