@@ -9,6 +9,7 @@
 #include "ofn/common/channels.hpp"
 #include "ofn/common/config.hpp"
 #include "ofn/common/logging.hpp"
+#include "ofn/common/sim_clock_guard.hpp"
 #include "ofn/sim_clock_t.hpp"
 
 namespace ofn {
@@ -66,10 +67,29 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
   // message, so each service steps in simulation time.
   // The first node owns the subscription, so its heartbeat counts bad
   // SIM_CLOCK messages like any other input.
+  // A stamp that jumps is refused (SimClockGuard); a restarted simulation is
+  // followed once it has kept to its new time, and every timer starts afresh.
   auto* follower = dynamic_cast<SimFollowClock*>(&clock);
+  auto guard = std::make_shared<SimClockGuard>();
   if (follower && !nodes.empty()) {
     nodes.front()->subscribe<sim_clock_t>(
-        channels::kSimClock, [follower](const sim_clock_t& m) { follower->update(m.utime); },
+        channels::kSimClock,
+        [follower, guard, nodes](const sim_clock_t& m) {
+          switch (guard->offer(m.utime)) {
+            case SimClockGuard::Verdict::kAccepted:
+              follower->update(m.utime);
+              break;
+            case SimClockGuard::Verdict::kRejected:
+              nodes.front()->reject(channels::kSimClock, guard->reason());
+              break;
+            case SimClockGuard::Verdict::kResynced:
+              nodes.front()->log().warn("SIM_CLOCK moved to a new timeline ({}): following it",
+                                        guard->reason());
+              follower->update(m.utime);
+              for (Node* node : nodes) node->restart_timers();
+              break;
+          }
+        },
         SubscribeOptions{0.0, 0.0});
   }
 
