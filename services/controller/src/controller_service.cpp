@@ -44,6 +44,28 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.selector.hold_deceleration =
       selector.number_in("hold_deceleration", c.selector.hold_deceleration, 0.01, 20.0);
   selector.finish();
+  YamlReader gate = r.child("command_gate");
+  c.gate.max_speed = gate.number_in("max_speed", c.gate.max_speed, 0.1, 100.0);
+  c.gate.max_vertical_speed =
+      gate.number_in("max_vertical_speed", c.gate.max_vertical_speed, 0.1, 100.0);
+  c.gate.max_accel = gate.number_in("max_accel", c.gate.max_accel, 0.1, 100.0);
+  YamlReader fence = gate.child("geofence");
+  const auto north =
+      fence.numbers_in("north", {c.gate.fence_min.x(), c.gate.fence_max.x()}, -1e6, 1e6);
+  const auto east =
+      fence.numbers_in("east", {c.gate.fence_min.y(), c.gate.fence_max.y()}, -1e6, 1e6);
+  // Altitude up, as a user reads it; the box is kept in NED.
+  const auto altitude =
+      fence.numbers_in("altitude", {-c.gate.fence_max.z(), -c.gate.fence_min.z()}, -1e4, 1e5);
+  for (const auto& [key, range] :
+       {std::pair<const char*, const std::vector<double>*>{"north", &north},
+        {"east", &east},
+        {"altitude", &altitude}})
+    if (!((*range)[0] < (*range)[1])) fence.fail(key, "expected [lowest, highest], lowest first");
+  c.gate.fence_min = Vec3(north[0], east[0], -altitude[1]);
+  c.gate.fence_max = Vec3(north[1], east[1], -altitude[0]);
+  fence.finish();
+  gate.finish();
   YamlReader outer = r.child("outer_loop");
   c.gains.position = read_vec3(outer, "position_gain", c.gains.position);
   c.gains.velocity = read_vec3(outer, "velocity_gain", c.gains.velocity);
@@ -144,6 +166,7 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
       controller_(config_.nominal, config_.gains, make_adaptive_element(config_.adaptive)),
       guidance_(config_.guidance),
       selector_(config_.selector),
+      gate_(config_.gate),
       path_heading_(config_.heading) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
@@ -168,6 +191,12 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
 void ControllerService::on_mission(const mission_t& m) {
   // The uplink repeats the plan; only a new id is a new plan.
   if (mission_ && same_plan(*mission_, m)) return;
+  // Limits beyond the airframe's or a waypoint outside the fence: the plan
+  // flown so far (or the hold) is kept.
+  if (const auto why = gate_.check_mission(limits_from(m.limits), waypoints_from(m))) {
+    node_.reject(channels::kMission, "mission refused: " + *why);
+    return;
+  }
   mission_ = m;
   mission_pending_ = true;
   // A new plan starts under guidance; the optimiser restarts with it.
@@ -182,6 +211,20 @@ void ControllerService::on_ref_traj(const ref_traj_t& m) {
     ref_traj_.reset();
     selector_.hand_back();
     return;
+  }
+  // Every sample inside the mission's envelope and the fence.
+  {
+    std::vector<double> times(m.sample_time.begin(), m.sample_time.end());
+    std::vector<Reference> samples(times.size());
+    for (size_t k = 0; k < samples.size(); ++k) {
+      samples[k].position = vec(m.position[k]);
+      samples[k].velocity = vec(m.velocity[k]);
+      samples[k].acceleration = vec(m.acceleration[k]);
+    }
+    if (const auto why = gate_.check_plan(times, samples, flight_limits())) {
+      node_.reject(channels::kRefTraj, "plan refused: " + *why);
+      return;
+    }
   }
   // Its state now (or at its start, if that is a few ms ahead of this
   // clock) against the reference flown now and the vehicle.
@@ -210,6 +253,10 @@ void ControllerService::on_ref_traj(const ref_traj_t& m) {
   }
   ref_traj_ = m;
   selector_.plan_flown();
+}
+
+Limits ControllerService::flight_limits() const {
+  return mission_ ? limits_from(mission_->limits) : gate_.airframe_limits();
 }
 
 void ControllerService::on_lidar_scan() {
@@ -319,6 +366,10 @@ void ControllerService::control_step() {
     node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
                      static_cast<int>(mode_), to_seconds(now));
   ref.yaw = yaw_reference(facing, dt, &ref.yaw_rate);
+  // Whatever chose it, the reference flown stays inside the envelope.
+  bool clamped = false;
+  ref = gate_.clamp(ref, flight_limits(), &clamped);
+  if (clamped) node_.reject("reference", "clamped into the envelope and the geofence");
 
   last_ref_ = ref;
   last_out_ = controller_.step(ref, x, dt);

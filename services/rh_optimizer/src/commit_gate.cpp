@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ofn/common/envelope.hpp"
+
 namespace ofn::rh {
 namespace {
 
@@ -85,12 +87,11 @@ CommitCheck CommitGate::check(const BsplineTrajectory& plan, double elapsed,
       2, static_cast<int>(std::ceil((plan.duration() - elapsed) / s.envelope_sample_spacing)));
   for (int k = 0; k <= envelope_samples; ++k) {
     const double t = elapsed + std::max(0.0, plan.duration() - elapsed) * k / envelope_samples;
-    const Vec3 v = plan.velocity(t), a = plan.acceleration(t);
-    const double speed_share = v.norm() / limits.max_speed;
-    const double climb_share = std::abs(v.z()) / limits.max_vertical_speed;
-    const double accel_share = a.norm() / limits.max_accel;
-    out.worst_envelope_share =
-        std::max({out.worst_envelope_share, speed_share, climb_share, accel_share});
+    const EnvelopeShares shares = envelope_shares(plan.velocity(t), plan.acceleration(t), limits);
+    const double speed_share = shares.speed;
+    const double climb_share = shares.vertical_speed;
+    const double accel_share = shares.acceleration;
+    out.worst_envelope_share = std::max(out.worst_envelope_share, shares.worst());
     if (!(speed_share <= over))
       return refuse(describe("speed share of the limit", speed_share, over, t));
     if (!(climb_share <= over))

@@ -8,6 +8,7 @@
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/controller/command_gate.hpp"
 #include "ofn/controller/heading_reference.hpp"
 #include "ofn/controller/neural_adaptation.hpp"
 #include "ofn/controller/reference_selector.hpp"
@@ -26,6 +27,7 @@ struct ControllerConfig {
   double nav_timeout = 0.2;       // s; older navigation counts as lost
   double ref_traj_timeout = 0.5;  // s; an older REF_TRAJ is no longer followed
   SelectorSettings selector;      // plan jumps refused; the stop when plans go stale
+  CommandGateSettings gate;       // airframe limits and geofence every command keeps
   ControllerGains gains;
   AdaptiveConfig adaptive;
   GuidanceConfig guidance;
@@ -55,6 +57,8 @@ class ControllerService {
   // reference flown now or on the vehicle.
   void on_ref_traj(const ref_traj_t& m);
   void on_lidar_scan();
+  /// The mission's limits; the airframe's before any mission.
+  Limits flight_limits() const;
   void control_step();
   void publish_status();
   double yaw_reference(const std::optional<Vec3>& facing, double dt, double* yaw_rate);
@@ -64,6 +68,7 @@ class ControllerService {
   TrajectoryController controller_;
   WaypointGuidance guidance_;
   ReferenceSelector selector_;
+  CommandGate gate_;
   std::optional<nav_state_t> nav_;
   std::optional<mission_t> mission_;
   bool mission_pending_ = false;
