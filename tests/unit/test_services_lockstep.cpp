@@ -336,6 +336,92 @@ TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
   EXPECT_NEAR(yaw_at(8.9), 90.0, 1e-6);
 }
 
+/// The rejections of `node` whose kind contains `text`.
+int64_t rejected_with(const Node& node, const std::string& text) {
+  int64_t n = 0;
+  for (const auto& [kind, count] : node.counters().rejected_by_reason)
+    if (kind.find(text) != std::string::npos) n += count;
+  return n;
+}
+
+TEST_F(LockstepServices, AForgedPlanBeyondTheSpeedLimitIsNeverFlown) {
+  // A stranger publishes a plan at 15 m/s (the mission allows 3.05): it
+  // starts on the vehicle, so only the envelope can refuse it.
+  sim::Lockstep lockstep;
+  const Scenario open = load_scenario(kOpenScenario);
+  const Vec3 here = open.waypoints.front().position;
+  NavFeeder nav(lockstep, here);
+  TrajectoryFeeder feeder(lockstep, uplink::mission_from_scenario(open, 1), here);
+  feeder.from = 1.0;
+  feeder.velocity = Vec3(15.0, 0, 0);
+  nav.velocity = feeder.velocity;
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  BusRecorder recorder(lockstep);
+  for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})
+    lockstep.add(*n);
+  lockstep.run(to_utime(3.0));
+  EXPECT_GE(rejected_with(controller.node(), "plan refused: leaves the envelope"), 15);
+  ASSERT_FALSE(recorder.status.empty());
+  for (const auto& st : recorder.status) {
+    ASSERT_NE(st.mode, control_status_t::TRAJECTORY) << "at " << to_seconds(st.utime);
+    EXPECT_LE(std::hypot(st.ref_velocity[0], st.ref_velocity[1], st.ref_velocity[2]),
+              1.02 * open.limits.max_speed);
+  }
+}
+
+TEST_F(LockstepServices, AMissionBeyondTheAirframeOrTheFenceIsRefused) {
+  sim::Lockstep lockstep;
+  const Scenario open = load_scenario(kOpenScenario);
+  const Vec3 here = open.waypoints.front().position;
+  NavFeeder nav(lockstep, here);
+  mission_t fast = uplink::mission_from_scenario(open, 1);
+  fast.limits.max_speed = 30.0;  // the airframe's configured limit is 10 m/s
+  TrajectoryFeeder feeder(lockstep, fast, here);
+  feeder.from = 1e9;  // missions only
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  for (Node* n : {&nav.node(), &feeder.node(), &controller.node()}) lockstep.add(*n);
+  lockstep.run(to_utime(1.0));
+  EXPECT_EQ(controller.mode(), control_status_t::HOLD);
+  EXPECT_GE(rejected_with(controller.node(), "mission refused: speed limit"), 5);
+
+  // A waypoint 5 km away: outside the default geofence.
+  sim::Lockstep lockstep2;
+  NavFeeder nav2(lockstep2, here);
+  mission_t far = uplink::mission_from_scenario(open, 1);
+  far.waypoints.back().position[0] = 5000.0;
+  TrajectoryFeeder feeder2(lockstep2, far, here);
+  feeder2.from = 1e9;
+  control::ControllerService controller2(lockstep2.lcm(), lockstep2.clock(),
+                                         default_controller_config());
+  for (Node* n : {&nav2.node(), &feeder2.node(), &controller2.node()}) lockstep2.add(*n);
+  lockstep2.run(to_utime(1.0));
+  EXPECT_EQ(controller2.mode(), control_status_t::HOLD);
+  EXPECT_GE(rejected_with(controller2.node(), "outside the geofence"), 5);
+}
+
+TEST_F(LockstepServices, VehicleSimRefusesActuatorCommandsBeyondTheAirframesRange) {
+  sim::Lockstep lockstep;
+  const Scenario open = load_scenario(kOpenScenario);
+  vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), open, default_sim_config());
+  Node stranger("stranger", lockstep.lcm(), lockstep.clock());
+  stranger.add_timer(
+      0.01,
+      [&] {
+        actuator_cmd_t c{};
+        c.utime = stranger.now();
+        c.collective = 0.1;
+        c.lon_cyclic = 0.9;  // the airframe's cyclic ends at 0.16 rad
+        stranger.publish(channels::kActuatorCmd, c);
+      },
+      "command");
+  lockstep.add(vehicle.node());
+  lockstep.add(stranger);
+  lockstep.run(to_utime(1.0));
+  EXPECT_GE(rejected_with(vehicle.node(), "longitudinal cyclic beyond its limits"), 90);
+}
+
 ref_traj_t three_sample_traj(Utime t0) {
   ref_traj_t m{};
   m.utime = t0;

@@ -36,6 +36,20 @@ RotorcraftState advance(const RotorcraftState& s, const RotorcraftDerivative& d,
 
 }  // namespace
 
+std::optional<std::string> controls_beyond_limits(const Controls& command,
+                                                  const RotorcraftParams& params,
+                                                  double tolerance) {
+  static const char* const kNames[4] = {"collective", "longitudinal cyclic", "lateral cyclic",
+                                        "pedal"};
+  const auto c = command.as_array();
+  const auto lo = params.min_controls.as_array();
+  const auto hi = params.max_controls.as_array();
+  for (int i = 0; i < 4; ++i)
+    if (!(c[i] >= lo[i] - tolerance && c[i] <= hi[i] + tolerance))
+      return std::string(kNames[i]) + " beyond its limits";
+  return std::nullopt;
+}
+
 RotorcraftModel::RotorcraftModel(RotorcraftParams params) : params_(std::move(params)) {}
 
 void RotorcraftModel::set_command(const Controls& command) {

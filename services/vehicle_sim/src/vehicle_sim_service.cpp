@@ -147,9 +147,17 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
 }
 
 void VehicleSimService::on_command(const actuator_cmd_t& m) {
+  // Beyond the configured airframe's actuator range no healthy controller
+  // commands: refused. A scenario's degraded servo (a narrower range) still
+  // saturates, as a real one does.
+  const Controls command{m.collective, m.lon_cyclic, m.lat_cyclic, m.pedal};
+  if (const auto why = controls_beyond_limits(command, config_.params)) {
+    node_.reject(channels::kActuatorCmd, *why);
+    return;
+  }
   last_command_time_ = node_.now();
   // Until released the vehicle flies its trim, whatever the controller says.
-  if (released_) vehicle_.set_command({m.collective, m.lon_cyclic, m.lat_cyclic, m.pedal});
+  if (released_) vehicle_.set_command(command);
 }
 
 void VehicleSimService::on_control_status(const control_status_t& m) {

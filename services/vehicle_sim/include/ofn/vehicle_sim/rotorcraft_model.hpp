@@ -11,6 +11,8 @@
 // gravity; actuator position limits, rate limits and servo lag.
 
 #include <array>
+#include <optional>
+#include <string>
 
 #include "ofn/common/frames.hpp"
 
@@ -98,6 +100,13 @@ struct RotorcraftDerivative {
   double flap_lon_dot = 0, flap_lat_dot = 0, inflow_dot = 0;
   std::array<double, 4> actuator_dot{};
 };
+
+/// Which actuator a command drives beyond its position limits (by more than
+/// `tolerance`, rad), or nullopt: the simulator refuses such a command
+/// rather than quietly clamp what no healthy controller sends.
+std::optional<std::string> controls_beyond_limits(const Controls& command,
+                                                  const RotorcraftParams& params,
+                                                  double tolerance = 1e-6);
 
 class RotorcraftModel {
  public:
