@@ -1,6 +1,8 @@
 // ofn_flight_monitor: watches a live flight on the bus, prints progress and
-// exits when the controller reports arrival at the last waypoint (0) or when
-// the wall-clock timeout passes (1). The launcher uses it to end a run.
+// exits when the vehicle has arrived at the last waypoint (0: the controller
+// says DONE for --linger seconds while navigation puts the vehicle there,
+// see ArrivalWatch) or when the wall-clock timeout passes (1). The launcher
+// uses it to end a run.
 
 #include <chrono>
 #include <cmath>
@@ -10,9 +12,12 @@
 #include <CLI/CLI.hpp>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/mission_plan.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/control_status_t.hpp"
+#include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
+#include "ofn/tools/arrival_watch.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"ofn flight monitor: progress of a live flight; exits when it is done"};
@@ -23,7 +28,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--every", report_period, "seconds of flight time between progress lines")
       ->check(CLI::PositiveNumber);
-  app.add_option("--linger", linger, "seconds of flight time to keep watching after arrival")
+  app.add_option("--linger", linger,
+                 "seconds of flight time over which every status must say DONE, with the "
+                 "vehicle at the last waypoint, before the flight counts as arrived")
       ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
@@ -33,15 +40,36 @@ int main(int argc, char** argv) {
     ofn::Node node("flight_monitor", *lcm, *clock);
     std::optional<ofn::nav_state_t> nav;
     int8_t mode = -1;
-    ofn::Utime done_at = INT64_MIN;
-    node.subscribe<ofn::nav_state_t>(ofn::channels::kNavState,
-                                     [&](const ofn::nav_state_t& m) { nav = m; });
+    ofn::report::ArrivalRules rules;
+    rules.linger = linger;
+    ofn::report::ArrivalWatch arrival(rules);
+    int64_t doubts_reported = 0;
+    node.subscribe<ofn::nav_state_t>(ofn::channels::kNavState, [&](const ofn::nav_state_t& m) {
+      nav = m;
+      arrival.on_navigation(m.utime, ofn::to_vec3(m.position));
+    });
+    node.subscribe<ofn::mission_t>(
+        ofn::channels::kMission,
+        [&](const ofn::mission_t& m) {
+          if (m.waypoints.empty()) return;
+          const auto& last = m.waypoints.back();
+          arrival.set_goal(ofn::to_vec3(last.position), last.capture_radius);
+        },
+        ofn::SubscribeOptions{0.0, 0.0});
     node.subscribe<ofn::control_status_t>(
         ofn::channels::kControlStatus, [&](const ofn::control_status_t& m) {
-          if (m.mode == ofn::control_status_t::DONE && done_at == INT64_MIN) {
-            done_at = m.utime;
-            std::cout << "monitor: arrived at the last waypoint at t=" << ofn::to_seconds(m.utime)
-                      << " s" << std::endl;
+          const bool had_arrived = arrival.arrived_at().has_value();
+          arrival.on_status(m.utime, m.mode == ofn::control_status_t::DONE);
+          if (!had_arrived && arrival.arrived_at())
+            std::cout << "monitor: arrived at the last waypoint at t="
+                      << ofn::to_seconds(*arrival.arrived_at()) << " s" << std::endl;
+          // A DONE that does not fit the vehicle's state is reported, once
+          // per kind of doubt run, not obeyed.
+          if (arrival.unconfirmed_done() > doubts_reported) {
+            if (doubts_reported == 0 || arrival.unconfirmed_done() % 100 == 1)
+              std::cout << "monitor: DONE not taken (" << arrival.last_doubt() << "; "
+                        << arrival.unconfirmed_done() << " so far)" << std::endl;
+            doubts_reported = arrival.unconfirmed_done();
           }
           mode = m.mode;
         });
@@ -64,7 +92,7 @@ int main(int argc, char** argv) {
     const auto wall_start = std::chrono::steady_clock::now();
     bool timed_out = false;
     ofn::run_nodes(*lcm, *clock, {&node}, [&] {
-      if (done_at != INT64_MIN && clock->now() - done_at >= ofn::to_utime(linger)) return false;
+      if (arrival.arrived_at()) return false;
       timed_out =
           std::chrono::steady_clock::now() - wall_start > std::chrono::duration<double>(timeout);
       return !timed_out;
@@ -73,6 +101,6 @@ int main(int argc, char** argv) {
       std::cerr << "monitor: no arrival within " << timeout << " s" << std::endl;
       return 1;
     }
-    return done_at != INT64_MIN ? 0 : 1;
+    return arrival.arrived_at() ? 0 : 1;
   });
 }
