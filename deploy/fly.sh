@@ -2,11 +2,7 @@
 # Flies a scenario through the real service processes on LCM udpm:// (in a
 # private network namespace when possible), records the bus, and writes the
 # flight report: CSV per channel, summary.json/.txt and the flight figure.
-#
-#   deploy/fly.sh [--scenario FILE] [--rtf X] [--out DIR] [--timeout S] [--host-network]
-#
-# Exit code: 1 when the flight's outcome is failure, else the launcher's
-# (0 when the run ended normally); 2 for bad arguments.
+# `make run` is this script with the Makefile's SCENARIO and RTF.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 scenario="$repo/sim/scenarios/bench3.yaml"
@@ -14,19 +10,67 @@ rtf=1.0
 timeout=300
 out=""
 netns=1
+
+usage() {
+  cat <<EOF
+usage: deploy/fly.sh [--scenario FILE] [--rtf X] [--out DIR] [--timeout S] [--host-network]
+
+Flies a scenario through the real service processes (deploy/launch.py) on
+LCM multicast, records the bus, and writes the flight report: a CSV per
+channel, summary.json, summary.txt and the figures flight.png, tracking.png.
+
+  --scenario FILE   scenario to fly (default: sim/scenarios/bench3.yaml)
+  --rtf X           simulation real-time factor (default: 1.0)
+  --out DIR         results folder (default: results/run-YYYYmmdd-HHMMSS)
+  --timeout S       wall-clock run limit in seconds (default: 300)
+  --host-network    run on the host network instead of a private network
+                    namespace (default: a namespace when one can be made)
+  -h, --help        show this help
+
+The flight's LCM log is named in DIR/latest_log; replay the most recent
+flight with 'deploy/replay.sh latest'.
+
+Example:
+  deploy/fly.sh --scenario sim/scenarios/popup.yaml --rtf 2
+
+Exit codes: 1 when the flight's outcome is failure; 2 for bad arguments or
+input, or when a service reported a configuration or usage error; otherwise
+the launcher's (0 when the run ended normally, 3 when the run limit ended
+it, 128+N when stopped by signal N).
+EOF
+}
+
+die_usage() {  # one line, exit code 2
+  echo "fly.sh: error: $* (see --help)" >&2
+  exit 2
+}
+
+need_value() {  # need_value OPTION NUMBER_OF_ARGS_LEFT
+  [[ $2 -ge 2 ]] || die_usage "$1 needs a value"
+}
+
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --scenario) scenario=$2; shift 2 ;;
-    --rtf) rtf=$2; shift 2 ;;
-    --out) out=$2; shift 2 ;;
-    --timeout) timeout=$2; shift 2 ;;
+    --scenario) need_value "$1" $#; scenario=$2; shift 2 ;;
+    --scenario=*) scenario=${1#*=}; shift ;;
+    --rtf) need_value "$1" $#; rtf=$2; shift 2 ;;
+    --rtf=*) rtf=${1#*=}; shift ;;
+    --out) need_value "$1" $#; out=$2; shift 2 ;;
+    --out=*) out=${1#*=}; shift ;;
+    --timeout) need_value "$1" $#; timeout=$2; shift 2 ;;
+    --timeout=*) timeout=${1#*=}; shift ;;
     --host-network) netns=0; shift ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
-    *) echo "fly.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+    -h|--help) usage; exit 0 ;;
+    *) die_usage "unknown option '$1'" ;;
   esac
 done
-[[ -f "$scenario" ]] || { echo "fly.sh: scenario file '$scenario' not found" >&2; exit 2; }
-[[ -x "$repo/build/bin/ofn_flight_report" ]] || { echo "fly.sh: not built yet: run 'make build'" >&2; exit 2; }
+positive='^([0-9]+\.?[0-9]*|\.[0-9]+)$'
+[[ $rtf =~ $positive ]] && awk -v x="$rtf" 'BEGIN { exit !(x > 0) }' ||
+  die_usage "--rtf must be a positive number, got '$rtf'"
+[[ $timeout =~ $positive ]] || die_usage "--timeout must be a number of seconds >= 0, got '$timeout'"
+[[ -n $scenario ]] || die_usage "--scenario is empty"
+[[ -f "$scenario" ]] || { echo "fly.sh: error: scenario file '$scenario' not found" >&2; exit 2; }
+[[ -x "$repo/build/bin/ofn_flight_report" ]] || { echo "fly.sh: error: not built yet: run 'make build'" >&2; exit 2; }
 [[ -n "$out" ]] || out="$repo/results/run-$(date +%Y%m%d-%H%M%S)"
 mkdir -p "$out"
 
@@ -39,6 +83,12 @@ if [[ $netns == 1 ]]; then
 else
   "${launch[@]}" || status=$?
 fi
+if [[ $status == 2 ]]; then
+  # The launcher rejected its input, or a service its configuration: there
+  # was no flight to report on (the launcher said why, above).
+  echo "fly: no flight: a configuration or usage error (see the launcher's message above)" >&2
+  exit 2
+fi
 [[ -f "$out/latest_log" ]] || { echo "fly: no flight log was recorded" >&2; exit 1; }
 log=$(cat "$out/latest_log")
 echo
@@ -49,6 +99,11 @@ report_status=0
   --controller-config "$repo/config/controller.yaml" --out "$out" || report_status=$?
 /usr/bin/python3 "$repo/services/tools/plot_flight.py" "$out" >/dev/null &&
   echo "  figures           : $out/flight.png, $out/tracking.png"
+# replay.sh's 'latest' is the newest flight in results/ or a folder just below.
+out_abs=$(cd "$out" && pwd)
+replay=$log
+[[ $out_abs == "$repo/results" || $(dirname "$out_abs") == "$repo/results" ]] && replay=latest
+echo "  replay            : deploy/replay.sh $replay"
 if [[ $report_status == 1 ]]; then
   echo "fly: the flight failed (see the outcome above)" >&2
   exit 1

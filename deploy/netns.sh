@@ -5,10 +5,31 @@
 # namespaces); with --fallback it runs the command directly when a
 # namespace cannot be made (LCM's ttl=0 still keeps multicast on the host).
 set -euo pipefail
+usage() {
+  cat <<EOF
+usage: deploy/netns.sh [--fallback] COMMAND [ARGS...]
+
+Runs COMMAND in a private network namespace whose loopback carries LCM
+multicast, so its traffic never leaves the machine.
+
+  --fallback   run COMMAND on the host network when no namespace can be made
+               (default: fail with exit code 1)
+  -h, --help   show this help
+
+Example:
+  deploy/netns.sh --fallback deploy/launch.py --scenario sim/scenarios/bench3.yaml
+
+Exit codes: COMMAND's; 2 for bad arguments; 1 when no namespace can be made
+and --fallback is not given.
+EOF
+}
 fallback=0
-if [[ "${1:-}" == "--fallback" ]]; then fallback=1; shift; fi
+case "${1:-}" in
+  -h|--help) usage; exit 0 ;;
+  --fallback) fallback=1; shift ;;
+esac
 if [[ $# -eq 0 ]]; then
-  echo "usage: deploy/netns.sh [--fallback] COMMAND [ARGS...]" >&2
+  echo "netns.sh: error: missing COMMAND (see --help)" >&2
   exit 2
 fi
 setup='ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo'

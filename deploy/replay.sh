@@ -21,36 +21,48 @@ usage: deploy/replay.sh LOGFILE [--speed X] [--lcm-url URL] [--loop]
 
 Publishes the messages of a recorded flight on LCM with their original timing.
 
-  LOGFILE           .lcm file written by deploy/launch.py (results/flight-*.lcm),
-                    or 'latest' for the file named in results/latest_log
-  --speed X         playback speed multiplier (default 1.0; 2 = twice as fast)
+  LOGFILE           .lcm file written by deploy/launch.py or deploy/fly.sh, or
+                    'latest' for the most recent flight: the newest of
+                    results/latest_log (deploy/launch.py) and
+                    results/*/latest_log (deploy/fly.sh, make run)
+  --speed X         playback speed multiplier (default: 1.0; 2 = twice as fast)
   --lcm-url URL     LCM URL to publish on
                     (default: \$LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)
   --loop            play the file again each time it ends (Ctrl-C to stop);
                     message timestamps jump back at every new pass
+                    (default: play it once)
   --channels REGEX  replay only channels matching this GLib regular expression
-  --verbose         print every replayed message
+                    (default: all channels)
+  -v, --verbose     print every replayed message
   -h, --help        show this help
+
+Exit codes: lcm-logplayer's; 2 for bad arguments or an unusable LOGFILE;
+1 when lcm-logplayer is missing or fails during --loop.
 
 Re-running onboard software on a recorded flight: start the services under
 test alongside the replay, e.g. in a second terminal
 
   deploy/launch.py --only mapper,global_planner --no-record --timeout 0 \\
-      --scenario <scenario of that flight>
-  deploy/replay.sh results/flight-YYYYmmdd-HHMMSS.lcm --channels '<their input channels>'
+      --scenario sim/scenarios/bench3.yaml      (the scenario of that flight)
+  deploy/replay.sh latest --channels '<their input channels>'
 
 Restrict --channels to the services' inputs so the recorded outputs of the
 old run do not mix with the new ones.  Watch the bus with deploy/spy.sh.
 EOF
 }
 
-die() {
+die() {  # the replay cannot run: exit code 1
     echo "replay.sh: error: $*" >&2
     exit 1
 }
 
+die_usage() {  # bad arguments or input: one line, exit code 2
+    echo "replay.sh: error: $* (see --help)" >&2
+    exit 2
+}
+
 need_value() {
-    [ "$2" -ge 2 ] || { usage >&2; die "$1 needs a value"; }
+    [ "$2" -ge 2 ] || die_usage "$1 needs a value"
 }
 
 while [ $# -gt 0 ]; do
@@ -64,30 +76,41 @@ while [ $# -gt 0 ]; do
         --loop)       LOOP=1; shift ;;
         --verbose|-v) VERBOSE=1; shift ;;
         -h|--help)    usage; exit 0 ;;
-        -*)           usage >&2; die "unknown option '$1'" ;;
+        -*)           die_usage "unknown option '$1'" ;;
         *)
-            [ -z "$LOGFILE" ] || { usage >&2; die "only one LOGFILE allowed (got '$LOGFILE' and '$1')"; }
+            [ -z "$LOGFILE" ] || die_usage "only one LOGFILE allowed (got '$LOGFILE' and '$1')"
             LOGFILE="$1"; shift ;;
     esac
 done
 
-[ -n "$LOGFILE" ] || { usage >&2; die "missing LOGFILE"; }
+[ -n "$LOGFILE" ] || die_usage "missing LOGFILE"
 
 if [ "$LOGFILE" = latest ]; then
-    LATEST="$REPO_ROOT/results/latest_log"
-    [ -f "$LATEST" ] || die "$LATEST not found: no flight recorded yet (run deploy/launch.py without --no-record)"
+    # deploy/launch.py writes <log dir>/latest_log, results/latest_log by
+    # default; deploy/fly.sh (make run) gives each flight its own folder,
+    # results/run-*/latest_log.  The newest of them is the latest flight.
+    LATEST=""
+    for candidate in "$REPO_ROOT/results/latest_log" "$REPO_ROOT"/results/*/latest_log; do
+        [ -f "$candidate" ] || continue
+        if [ -z "$LATEST" ] || [ "$candidate" -nt "$LATEST" ]; then
+            LATEST="$candidate"
+        fi
+    done
+    [ -n "$LATEST" ] || die_usage "no flight recorded yet: neither results/latest_log nor results/*/latest_log exists (fly one with make run)"
     LOGFILE="$(head -n 1 "$LATEST")"
+    [ -n "$LOGFILE" ] || die_usage "$LATEST is empty"
+    echo "replay.sh: latest flight, from $LATEST"
 fi
-[ -e "$LOGFILE" ] || die "log file '$LOGFILE' not found"
-[ -f "$LOGFILE" ] || die "'$LOGFILE' is not a regular file"
-[ -r "$LOGFILE" ] || die "log file '$LOGFILE' is not readable"
-[ -s "$LOGFILE" ] || die "log file '$LOGFILE' is empty (nothing was recorded)"
+[ -e "$LOGFILE" ] || die_usage "log file '$LOGFILE' not found"
+[ -f "$LOGFILE" ] || die_usage "'$LOGFILE' is not a regular file"
+[ -r "$LOGFILE" ] || die_usage "log file '$LOGFILE' is not readable"
+[ -s "$LOGFILE" ] || die_usage "log file '$LOGFILE' is empty (nothing was recorded)"
 
 # A positive decimal number; lcm-logplayer would otherwise misbehave quietly.
 [[ "$SPEED" =~ ^([0-9]+\.?[0-9]*|\.[0-9]+)$ ]] && awk -v s="$SPEED" 'BEGIN { exit !(s > 0) }' \
-    || die "--speed must be a positive number, got '$SPEED'"
+    || die_usage "--speed must be a positive number, got '$SPEED'"
 
-command -v lcm-logplayer >/dev/null 2>&1 || die "lcm-logplayer not found: apt-get install lcm"
+command -v lcm-logplayer >/dev/null 2>&1 || die "lcm-logplayer not found: apt-get install liblcm-bin"
 
 PLAYER=(lcm-logplayer "--speed=$SPEED" "--lcm-url=$LCM_URL")
 [ -z "$CHANNELS" ] || PLAYER+=("--regexp=$CHANNELS")

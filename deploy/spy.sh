@@ -24,6 +24,9 @@ Opens lcm-spy on the flight-software LCM bus with the ofn_* message types.
                   (default: \$LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)
   -h, --help      show this help
 
+Exit codes: lcm-spy's; 2 for bad arguments; 1 when something it needs is
+missing.
+
 Needs a display (DISPLAY set; over ssh use 'ssh -X'), Java
 (apt-get install default-jre) and the type jar from 'make build'
 (override its path with OFN_LCMTYPES_JAR).  Extra jars can be added through
@@ -31,15 +34,20 @@ CLASSPATH.
 EOF
 }
 
-die() {
+die() {  # something lcm-spy needs is missing: exit code 1
     echo "spy.sh: error: $*" >&2
     exit 1
+}
+
+die_usage() {  # bad arguments: one line, exit code 2
+    echo "spy.sh: error: $* (see --help)" >&2
+    exit 2
 }
 
 while [ $# -gt 0 ]; do
     case "$1" in
         --lcm-url)
-            [ $# -ge 2 ] || die "--lcm-url needs a URL"
+            [ $# -ge 2 ] || die_usage "--lcm-url needs a URL"
             LCM_URL="$2"
             shift 2
             ;;
@@ -52,8 +60,7 @@ while [ $# -gt 0 ]; do
             exit 0
             ;;
         *)
-            usage >&2
-            die "unknown argument '$1'"
+            die_usage "unknown argument '$1'"
             ;;
     esac
 done
@@ -61,6 +68,7 @@ done
 command -v java >/dev/null 2>&1 || die "java not found: apt-get install default-jre"
 [ -f "$LCM_JAR" ] || die "$LCM_JAR not found: apt-get install liblcm-java"
 [ -f "$JCHART_JAR" ] || die "$JCHART_JAR not found: apt-get install libjchart2d-java"
+[ -n "$LCM_URL" ] || die_usage "--lcm-url is empty"
 [ -f "$TYPES_JAR" ] || die "LCM type jar $TYPES_JAR not found: run make build"
 if [ -z "${DISPLAY:-}" ]; then
     die "no DISPLAY set: lcm-spy is a GUI; run it in a desktop session or over 'ssh -X'"
