@@ -17,7 +17,6 @@ Each flight's folder (OUT/COURSE/, OUT/multiprocess-COURSE/) keeps the
 runner's CSVs, summary.json and LCM log. Exit code 1 when any flight fails
 the benchmark verdict (the report is written anyway), 2 for bad arguments.
 """
-import argparse
 import concurrent.futures
 import datetime
 import hashlib
@@ -67,7 +66,7 @@ def bin_path(build, name):
 
 def timed_obstacles(scenario):
     """Number of the scenario's obstacles with an appear_time or a disappear_time (pop-ups)."""
-    import yaml
+    yaml = cr.need("yaml")
     try:
         with open(scenario) as f:
             doc = yaml.safe_load(f) or {}
@@ -184,7 +183,7 @@ def process_table(config_dir, out_dir):
     table = os.path.join(REPO, "deploy", "processes.yaml")
     if os.path.realpath(config_dir) == os.path.realpath(DEFAULT_CONFIG):
         return table
-    import yaml
+    yaml = cr.need("yaml")
     with open(table) as f:
         doc = yaml.safe_load(f)
     for entry in doc.get("processes", doc) if isinstance(doc, dict) else doc:
@@ -203,7 +202,7 @@ def run_multiprocess(build, scenario, out_dir, rtf, config_dir=DEFAULT_CONFIG):
     if os.path.isdir(out_dir):
         shutil.rmtree(out_dir)
     os.makedirs(out_dir)
-    import yaml
+    yaml = cr.need("yaml")
     with open(scenario) as f:
         max_time = float((yaml.safe_load(f) or {}).get("max_time", 600))
     timeout = max_time / rtf + MULTIPROCESS_SLACK_S
@@ -464,31 +463,65 @@ def describe(label, rec):
 
 # --------------------------------------------------------------------------- main
 
-def parse_args(argv):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--build", default=os.path.join(REPO, "build"), help="build folder (binaries in DIR/bin)")
-    ap.add_argument("--out", default=os.path.join(REPO, "results", "campaign"))
-    ap.add_argument("--courses", help="comma-separated course names (default: all seven)")
-    ap.add_argument("--jobs", type=int, default=2, help="lockstep flights at a time")
+PROG = "bench/campaign.py"
+
+
+def build_parser():
+    ap = cr.ArgumentParser(
+        PROG, __doc__.splitlines()[0],
+        epilog="Flies every course in the lockstep runner, one course through the nine\n"
+               "processes, computes the time-optimal baselines when the build has\n"
+               "ofn_baseline, and writes OUT/report.md, OUT/results.json and a figure per\n"
+               "course.\n"
+               "\n"
+               "Examples:\n"
+               "  bench/campaign.py --quick\n"
+               "  bench/campaign.py --courses bench3,tree --multiprocess none --jobs 1\n"
+               "\n"
+               "Exit codes: 0 when every flight passes; 1 when any fails the benchmark\n"
+               "verdict (the report is written anyway); 2 for bad arguments, a missing\n"
+               "build or a missing Python module (PyYAML, numpy, matplotlib).")
+    ap.add_argument("--build", default=os.path.join(REPO, "build"), metavar="DIR",
+                    help="build folder, binaries in DIR/bin (default: build)")
+    ap.add_argument("--out", default=os.path.join(REPO, "results", "campaign"), metavar="DIR",
+                    help="results folder (default: results/campaign)")
+    ap.add_argument("--courses", metavar="NAME[,NAME]",
+                    help="comma-separated courses of sim/scenarios/ (default: %s; with --quick %s)"
+                         % (",".join(COURSES), ",".join(QUICK_COURSES)))
+    ap.add_argument("--jobs", type=int, default=2, metavar="N",
+                    help="lockstep flights at a time (default: 2)")
     ap.add_argument("--multiprocess", default=None, metavar="COURSE|none",
-                    help="course flown through the multi-process deployment (default bench3)")
-    ap.add_argument("--rtf", type=float, default=1.0, help="real-time factor of the multi-process flight")
-    ap.add_argument("--config-dir", default=DEFAULT_CONFIG, help="services' config files (default: the repository's)")
-    ap.add_argument("--baseline-cache", help="baseline cache folder (default OUT/baselines)")
-    ap.add_argument("--quick", action="store_true", help="bench1 and bench4 only, no multi-process flight")
+                    help="course flown through the multi-process deployment "
+                         "(default: bench3; with --quick none)")
+    ap.add_argument("--rtf", type=float, default=1.0, metavar="X",
+                    help="real-time factor of the multi-process flight (default: 1.0)")
+    ap.add_argument("--config-dir", default=DEFAULT_CONFIG, metavar="DIR",
+                    help="services' config files (default: config)")
+    ap.add_argument("--baseline-cache", metavar="DIR", help="baseline cache folder (default: OUT/baselines)")
+    ap.add_argument("--quick", action="store_true",
+                    help="bench1 and bench4 only, no multi-process flight (default: off)")
+    return ap
+
+
+def parse_args(argv):
+    ap = build_parser()
     args = ap.parse_args(argv)
     courses = args.courses.split(",") if args.courses else (QUICK_COURSES if args.quick else COURSES)
     args.courses = [c.strip() for c in courses if c.strip()]
+    if not args.courses:
+        ap.error("--courses: no course given")
     if args.multiprocess is None:
         args.multiprocess = "none" if args.quick else "bench3"
     for c in args.courses + ([] if args.multiprocess == "none" else [args.multiprocess]):
         if not os.path.isfile(scenario_path(c)):
-            ap.error("no scenario file %s" % scenario_path(c))
-    if args.jobs < 1 or args.rtf <= 0:
+            ap.error("no scenario file %s" % cr.rel(scenario_path(c)))
+    if args.jobs < 1 or not args.rtf > 0:
         ap.error("--jobs must be >= 1 and --rtf > 0")
     args.build = os.path.abspath(args.build)
     args.out = os.path.abspath(args.out)
     args.config_dir = os.path.abspath(args.config_dir)
+    if not os.path.isdir(args.config_dir):
+        ap.error("--config-dir: no folder %s" % args.config_dir)
     if not os.access(bin_path(args.build, "ofn_sim_runner"), os.X_OK):
         ap.error("no ofn_sim_runner in %s/bin (build first, or pass --build)" % args.build)
     return args
@@ -496,6 +529,9 @@ def parse_args(argv):
 
 def main(argv=None):
     args = parse_args(argv)
+    # Everything the report needs, before minutes of flying.
+    cr.need("yaml")
+    cr.need_plotting()
     os.makedirs(args.out, exist_ok=True)
     cache = os.path.abspath(args.baseline_cache or os.path.join(args.out, "baselines"))
     t_start = time.monotonic()
@@ -584,4 +620,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    cr.run_main(PROG, main)

@@ -9,22 +9,28 @@ the course figure of one results folder:
 All inputs are SI, local NED (summary.json, nav_state.csv, control_status.csv,
 scan_points.csv, baseline_trajectory.csv); figures and tables use the course
 frame (x = north, y = east, h = -down) in the display unit of summary.json.
+
+It also holds what the bench scripts' command lines share: the project
+version, one-line usage errors (exit code 2) and the third-party modules
+(PyYAML, numpy, matplotlib), which are imported only when first needed, so
+that --help and the argument checks work without them.
 """
 import argparse
+import importlib
 import json
 import math
 import os
+import re
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(REPO, "services", "tools"))
 
-import plot_flight as pf  # noqa: E402  (sets the Agg backend)
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.patches import Circle, Polygon, Rectangle  # noqa: E402
-from matplotlib.ticker import MaxNLocator  # noqa: E402
+# Set by _plotting() on first use: services/tools/plot_flight.py (which picks
+# the Agg backend), matplotlib and numpy.
+pf = plt = np = None
+Circle = Polygon = Rectangle = MaxNLocator = None
 
 RECONSTRUCTION_NOTE = ("The course geometry is this project's reconstruction of the rotorcraft "
                        "obstacle-field-navigation benchmarks (/work/shared/BENCHMARKS.md), "
@@ -32,6 +38,92 @@ RECONSTRUCTION_NOTE = ("The course geometry is this project's reconstruction of 
 MAX_SCAN_POINTS = 20000  # LIDAR hits drawn per view; more only slows the figure down
 FAIL_LINE = 0.8  # share of R_s below which a run fails (BENCHMARKS.md)
 SMOOTHING_S = 0.5
+
+
+# --------------------------------------------------------------------------- command lines
+
+EXIT_USAGE = 2
+DEBIAN_PACKAGES = {"yaml": "python3-yaml", "numpy": "python3-numpy",
+                   "matplotlib": "python3-matplotlib"}
+
+
+class MissingModule(Exception):
+    """A third-party module a task needs cannot be imported; exit code 2."""
+
+
+def need(name):
+    """The module `name`, imported now; MissingModule when it cannot be."""
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        missing = (getattr(exc, "name", None) or name).split(".")[0]
+        package = DEBIAN_PACKAGES.get(missing, DEBIAN_PACKAGES.get(name.split(".")[0]))
+        raise MissingModule("the Python module %s is needed but cannot be imported (%s)%s"
+                            % (missing, " ".join(str(exc).split()),
+                               "; Debian: apt-get install %s" % package if package else ""))
+
+
+def _plotting():
+    """Import plot_flight, matplotlib and numpy on first use."""
+    global pf, plt, np, Circle, Polygon, Rectangle, MaxNLocator
+    if pf is None:
+        need("numpy")
+        need("matplotlib")
+        pf = need("plot_flight")  # sets the Agg backend before pyplot
+        plt = need("matplotlib.pyplot")
+        np = need("numpy")
+        patches = need("matplotlib.patches")
+        Circle, Polygon, Rectangle = patches.Circle, patches.Polygon, patches.Rectangle
+        MaxNLocator = need("matplotlib.ticker").MaxNLocator
+
+
+def need_plotting():
+    """Fail early (MissingModule) when the figures could not be drawn."""
+    _plotting()
+
+
+def project_version():
+    """The project's version, defined in one place: project(... VERSION x.y.z)
+    in the top-level CMakeLists.txt."""
+    try:
+        with open(os.path.join(REPO, "CMakeLists.txt"), encoding="utf-8") as f:
+            match = re.search(r"^\s*project\s*\([^)]*\bVERSION\s+([0-9][0-9A-Za-z.+-]*)", f.read(),
+                              re.MULTILINE | re.IGNORECASE)
+    except OSError:
+        match = None
+    return match.group(1) if match else "unknown"
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with one-line usage errors (exit code 2), the description and
+    epilog shown as written, and --version."""
+
+    def __init__(self, prog, description, epilog=None):
+        super().__init__(prog=prog, description=description, epilog=epilog,
+                         formatter_class=argparse.RawDescriptionHelpFormatter)
+        self.add_argument("--version", action="version", version="%(prog)s " + project_version())
+
+    def error(self, message):
+        self.exit(EXIT_USAGE, "%s: error: %s (see --help)\n" % (self.prog, message))
+
+
+def run_main(prog, main):
+    """sys.exit(main()), with a missing module reported in one line (exit code 2)."""
+    try:
+        code = main()
+    except MissingModule as exc:
+        sys.stderr.write("%s: error: %s\n" % (prog, exc))
+        code = EXIT_USAGE
+    except KeyboardInterrupt:
+        sys.stderr.write("%s: interrupted\n" % prog)
+        code = 130
+    sys.exit(code)
+
+
+def rel(path):
+    """A path as shown in help texts: relative to the repository when inside it."""
+    r = os.path.relpath(path, REPO)
+    return path if r.startswith("..") else r
 
 
 # --------------------------------------------------------------------------- reading
@@ -48,6 +140,7 @@ def load_csv(folder, name):
     """{column: array} or None when the file is missing."""
     if folder is None or not os.path.isfile(os.path.join(folder, name)):
         return None
+    _plotting()
     return pf.load_csv(folder, name, False)
 
 
@@ -127,9 +220,12 @@ def course_figure(run_dir, out_png, title=None, baseline_dir=None, tree_views=Fa
     (commanded vs actual) and, for sensor-in-the-loop courses, front and side
     views with the LIDAR hits. Returns out_png, or None when the flight left no data."""
     summary = read_json(os.path.join(run_dir, "summary.json"))
+    if summary is None or not os.path.isfile(os.path.join(run_dir, "nav_state.csv")):
+        return None
+    _plotting()
     nav = load_csv(run_dir, "nav_state.csv")
     ctl = load_csv(run_dir, "control_status.csv")
-    if summary is None or nav is None:
+    if nav is None:
         return None
     base = load_csv(baseline_dir, "baseline_trajectory.csv")
     unit, k = unit_scale(summary)
@@ -225,6 +321,7 @@ def course_figure(run_dir, out_png, title=None, baseline_dir=None, tree_views=Fa
 
 def histogram(out_png, values, xlabel, title, lines=(), bins=30):
     """A histogram with labelled vertical reference lines [(x, label, colour)]."""
+    _plotting()
     fig, ax = plt.subplots(figsize=(7, 4))
     vals = [v for v in values if v is not None and math.isfinite(v)]
     if vals:
@@ -326,20 +423,42 @@ def wilson_interval(successes, n, z=1.959964):
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("results_dir")
-    ap.add_argument("--baseline", help="folder with baseline_trajectory.csv")
-    ap.add_argument("--out", help="figure path (default RESULTS_DIR/course.png)")
-    ap.add_argument("--tree", action="store_true", help="add front and side views with the LIDAR hits")
-    args = ap.parse_args()
+PROG = "bench/campaign_report.py"
+
+
+def build_parser():
+    ap = ArgumentParser(
+        PROG, "Draw the course figure of one flight's results folder (as the campaign does).",
+        epilog="Example:\n"
+               "  bench/campaign_report.py results/campaign/bench1 --out /tmp/bench1.png\n"
+               "      (after bench/campaign.py has flown bench1)\n"
+               "\n"
+               "Exit codes: 0 when the figure is written; 2 for bad arguments, a folder\n"
+               "without summary.json / nav_state.csv, or matplotlib/numpy missing.")
+    ap.add_argument("results_dir", metavar="RESULTS_DIR",
+                    help="a flight's folder: summary.json, nav_state.csv, ... (required)")
+    ap.add_argument("--baseline", metavar="DIR",
+                    help="folder with baseline_trajectory.csv, drawn dashed (default: none)")
+    ap.add_argument("--out", metavar="FILE", help="figure path (default: RESULTS_DIR/course.png)")
+    ap.add_argument("--tree", action="store_true",
+                    help="add front and side views with the LIDAR hits (default: off)")
+    return ap
+
+
+def main(argv=None):
+    ap = build_parser()
+    args = ap.parse_args(argv)
+    if not os.path.isdir(args.results_dir):
+        ap.error("RESULTS_DIR: no folder %s" % args.results_dir)
+    if args.baseline is not None and not os.path.isdir(args.baseline):
+        ap.error("--baseline: no folder %s" % args.baseline)
     out = args.out or os.path.join(args.results_dir, "course.png")
     if course_figure(args.results_dir, out, baseline_dir=args.baseline, tree_views=args.tree) is None:
-        print("campaign_report: no summary.json / nav_state.csv in %s" % args.results_dir, file=sys.stderr)
-        return 2
+        print("%s: error: no summary.json / nav_state.csv in %s" % (PROG, args.results_dir), file=sys.stderr)
+        return EXIT_USAGE
     print(out)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_main(PROG, main)

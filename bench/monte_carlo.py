@@ -30,7 +30,6 @@ dense fields, 1 when any field fails (a failure outcome, a safe stop
 although the baseline finds a route, a clearance below 0.8 R_s or a limit
 exceeded); 2 for bad arguments. The report is written either way.
 """
-import argparse
 import json
 import math
 import os
@@ -390,28 +389,59 @@ def median(values):
     return vals[mid] if len(vals) % 2 else 0.5 * (vals[mid - 1] + vals[mid])
 
 
-def parse_args(argv):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--build", default=os.path.join(REPO, "build"), help="build folder (binaries in DIR/bin)")
-    ap.add_argument("--runs", type=int, default=None, help="number of fields (default 300)")
-    ap.add_argument("--seed-base", "--seed", dest="seed_base", type=int, default=1,
-                    help="seed of the first field; field i has seed S + i (default 1)")
-    ap.add_argument("--seeds", help="comma-separated seeds to fly, e.g. 64,131,257 (instead of "
-                    "--seed-base and --runs)")
-    ap.add_argument("--jobs", type=int, default=2, help="flights at a time")
-    ap.add_argument("--out", default=os.path.join(REPO, "results", "monte_carlo"))
-    ap.add_argument("--config-dir", default=campaign.DEFAULT_CONFIG,
-                    help="services' config files (default: the repository's)")
-    ap.add_argument("--template", default=random_field.DEFAULT_TEMPLATE,
-                    help="scenario whose course the fields use (default bench1)")
+PROG = "bench/monte_carlo.py"
+DEFAULT_RUNS = 300
+
+
+def build_parser():
+    ap = cr.ArgumentParser(
+        PROG, __doc__.splitlines()[0],
+        epilog="Field i is bench/random_field.py's field of seed S + i (fair, or dense with\n"
+               "--dense), flown in the lockstep runner; writes OUT/report.md, OUT/results.json,\n"
+               "histograms and, for failed runs, a figure each.  The rules are in this\n"
+               "file's docstring and in bench/random_field.py.\n"
+               "\n"
+               "Examples:\n"
+               "  bench/monte_carlo.py --quick\n"
+               "  bench/monte_carlo.py --dense --runs 50 --out /tmp/dense\n"
+               "  bench/monte_carlo.py --seeds 64,131,257 --keep-all\n"
+               "\n"
+               "Exit codes: fair fields, 1 when the success rate is below %.0f %%; dense fields,\n"
+               "1 when any field fails; 2 for bad arguments, a missing build or a missing\n"
+               "Python module (PyYAML, numpy, matplotlib).  The report is written either way."
+               % (100 * SUCCESS_GOAL))
+    ap.add_argument("--build", default=os.path.join(REPO, "build"), metavar="DIR",
+                    help="build folder, binaries in DIR/bin (default: build)")
+    ap.add_argument("--runs", type=int, default=None, metavar="N",
+                    help="number of fields (default: %d; with --quick %d)" % (DEFAULT_RUNS, QUICK_RUNS))
+    ap.add_argument("--seed-base", "--seed", dest="seed_base", type=int, default=1, metavar="S",
+                    help="seed of the first field; field i has seed S + i (default: 1)")
+    ap.add_argument("--seeds", metavar="S[,S]",
+                    help="comma-separated seeds to fly, e.g. 64,131,257 "
+                         "(default: --seed-base and --runs)")
+    ap.add_argument("--jobs", type=int, default=2, metavar="N", help="flights at a time (default: 2)")
+    ap.add_argument("--out", default=os.path.join(REPO, "results", "monte_carlo"), metavar="DIR",
+                    help="results folder (default: results/monte_carlo)")
+    ap.add_argument("--config-dir", default=campaign.DEFAULT_CONFIG, metavar="DIR",
+                    help="services' config files (default: config)")
+    ap.add_argument("--template", default=random_field.DEFAULT_TEMPLATE, metavar="FILE",
+                    help="scenario whose course the fields use (default: %s)"
+                         % cr.rel(random_field.DEFAULT_TEMPLATE))
     ap.add_argument("--dense", action="store_true",
                     help="dense fields (10-25 obstacles, 15 ft gaps, may be sealed) instead of fair ones; "
-                    "exit code 1 when any field fails")
-    ap.add_argument("--baseline-cache", help="baseline cache folder (default OUT/baselines)")
+                    "exit code 1 when any field fails (default: fair fields)")
+    ap.add_argument("--baseline-cache", metavar="DIR",
+                    help="baseline cache folder (default: OUT/baselines)")
     ap.add_argument("--keep-failures", action="store_true",
-                    help="also keep the LCM logs of failed runs (their CSVs are always kept)")
-    ap.add_argument("--keep-all", action="store_true", help="keep every run's folder, log included")
-    ap.add_argument("--quick", action="store_true", help="%d fields" % QUICK_RUNS)
+                    help="also keep the LCM logs of failed runs; their CSVs are always kept (default: off)")
+    ap.add_argument("--keep-all", action="store_true",
+                    help="keep every run's folder, log included (default: off)")
+    ap.add_argument("--quick", action="store_true", help="%d fields (default: off)" % QUICK_RUNS)
+    return ap
+
+
+def parse_args(argv):
+    ap = build_parser()
     args = ap.parse_args(argv)
     if args.seeds is not None:
         try:
@@ -424,7 +454,7 @@ def parse_args(argv):
             ap.error("--seeds: a seed is given twice")
         args.runs = len(args.seeds)
     if args.runs is None:
-        args.runs = QUICK_RUNS if args.quick else 300
+        args.runs = QUICK_RUNS if args.quick else DEFAULT_RUNS
     if args.runs < 1 or args.jobs < 1:
         ap.error("--runs and --jobs must be >= 1")
     if args.seeds is None:
@@ -433,6 +463,10 @@ def parse_args(argv):
     args.out = os.path.abspath(args.out)
     args.config_dir = os.path.abspath(args.config_dir)
     args.baseline_cache = os.path.abspath(args.baseline_cache or os.path.join(args.out, "baselines"))
+    if not os.path.isfile(args.template):
+        ap.error("--template: no file %s" % args.template)
+    if not os.path.isdir(args.config_dir):
+        ap.error("--config-dir: no folder %s" % args.config_dir)
     if not os.access(campaign.bin_path(args.build, "ofn_sim_runner"), os.X_OK):
         ap.error("no ofn_sim_runner in %s/bin (build first, or pass --build)" % args.build)
     return args
@@ -440,7 +474,14 @@ def parse_args(argv):
 
 def main(argv=None):
     args = parse_args(argv)
-    template = random_field.load_template(args.template)
+    # Everything the report needs, before hours of flying.
+    cr.need("yaml")
+    cr.need_plotting()
+    try:
+        template = random_field.load_template(args.template)
+    except (OSError, ValueError) as exc:
+        print("%s: error: --template: %s" % (PROG, exc), file=sys.stderr)
+        return cr.EXIT_USAGE
     for sub in ("fields", "runs", "failure-figures"):
         path = os.path.join(args.out, sub)
         if sub != "fields" and os.path.isdir(path):
@@ -490,4 +531,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    cr.run_main(PROG, main)

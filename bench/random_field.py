@@ -64,15 +64,17 @@ of them are tall (top 250..300, to be passed beside) and the rest have a top
 anywhere in 40..250, low ones to climb over mixed with ones whose climb costs
 about as much as a detour.
 """
-import argparse
 import math
 import os
 import random
 import sys
 
-import yaml
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import campaign_report as cr  # noqa: E402  (command-line helpers; imports nothing heavy)
+
+REPO = os.path.dirname(HERE)
 DEFAULT_TEMPLATE = os.path.join(REPO, "sim", "scenarios", "bench1.yaml")
 
 FIELD_X_MIN, FIELD_X_MAX = 60.0, 360.0
@@ -103,8 +105,18 @@ MAX_DRAWS = 10000
 
 
 def load_template(path):
-    with open(path) as f:
-        tpl = yaml.safe_load(f)
+    """The template scenario; ValueError (one line) when it is not a usable one."""
+    yaml = cr.need("yaml")
+    try:
+        with open(path) as f:
+            tpl = yaml.safe_load(f)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = " line %d, column %d:" % (mark.line + 1, mark.column + 1) if mark is not None else ""
+        raise ValueError("%s: not valid YAML:%s %s" % (path, where, getattr(exc, "problem", None)
+                                                      or " ".join(str(exc).split())))
+    if not isinstance(tpl, dict):
+        raise ValueError("%s: template is not a scenario (its top level is not a mapping)" % path)
     for key in ("units", "start", "waypoints", "limits", "gates"):
         if key not in tpl:
             raise ValueError("%s: template has no '%s'" % (path, key))
@@ -424,24 +436,47 @@ def write_field(seed, path, template=DEFAULT_TEMPLATE, dense=False):
     return obstacles
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seed", type=int, required=True)
-    ap.add_argument("--out", required=True, help="scenario file to write")
-    ap.add_argument("--template", default=DEFAULT_TEMPLATE,
-                    help="scenario whose course (start, waypoints, limits, gates) is used")
+PROG = "bench/random_field.py"
+
+
+def build_parser():
+    ap = cr.ArgumentParser(
+        PROG, __doc__.splitlines()[0],
+        epilog="The rules of both classes of field are in this file's docstring.\n"
+               "\n"
+               "Examples:\n"
+               "  bench/random_field.py --seed 7 --out /tmp/field-7.yaml\n"
+               "  bench/random_field.py --dense --seed 7 --template sim/scenarios/bench1.yaml \\\n"
+               "      --out /tmp/dense-7.yaml\n"
+               "\n"
+               "Exit codes: 0 when the field is written; 2 for bad arguments, an unusable\n"
+               "template, a file that cannot be written or PyYAML missing.")
+    ap.add_argument("--seed", type=int, required=True, metavar="S",
+                    help="random seed; the same seed always gives the same field (required)")
+    ap.add_argument("--out", required=True, metavar="FILE", help="scenario file to write (required)")
+    ap.add_argument("--template", default=DEFAULT_TEMPLATE, metavar="FILE",
+                    help="scenario whose course (start, waypoints, limits, gates) is used "
+                         "(default: %s)" % cr.rel(DEFAULT_TEMPLATE))
     ap.add_argument("--dense", action="store_true",
-                    help="a dense field (10-25 obstacles, 15 ft gaps, may be sealed) instead of a fair one")
-    args = ap.parse_args()
+                    help="a dense field (10-25 obstacles, 15 ft gaps, may be sealed) instead of "
+                         "a fair one (default: fair)")
+    return ap
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
     try:
         obstacles = write_field(args.seed, args.out, args.template, args.dense)
-    except (OSError, ValueError, RuntimeError) as exc:
-        print("random_field: error: %s" % exc, file=sys.stderr)
-        return 2
+    except OSError as exc:
+        print("%s: error: %s: %s" % (PROG, exc.filename or args.out, exc.strerror), file=sys.stderr)
+        return cr.EXIT_USAGE
+    except (ValueError, RuntimeError) as exc:
+        print("%s: error: %s" % (PROG, exc), file=sys.stderr)
+        return cr.EXIT_USAGE
     print("%s: %d obstacles (%d tall)" % (args.out, len(obstacles),
                                           sum(1 for o in obstacles if is_tall(o))))
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    cr.run_main(PROG, main)
