@@ -1,0 +1,405 @@
+"""Command lines of the deploy and bench scripts: help, usage errors, versions,
+and `deploy/replay.sh latest` after a flight flown by deploy/fly.sh.
+
+Needs no build, no network and no LCM: flights use a small process table of
+shell commands, and lcm-logger, lcm-logplayer, ofn_flight_report and
+plot_flight.py are replaced by stand-ins in a scratch copy of the
+repository.  The bench scripts' third-party modules are hidden by stub
+packages that fail to import.
+
+Run from the repository root:
+    /usr/bin/python3 -m unittest tests/integration/test_cli_usage.py
+"""
+
+import importlib.util
+import os
+import re
+import shutil
+import stat
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+import unittest
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DEPLOY = os.path.join(REPO_ROOT, "deploy")
+BENCH = os.path.join(REPO_ROOT, "bench")
+BENCH_SCRIPTS = ("monte_carlo.py", "campaign.py", "random_field.py", "campaign_report.py")
+HIDDEN_MODULES = ("numpy", "matplotlib", "yaml")
+
+
+def project_version():
+    with open(os.path.join(REPO_ROOT, "CMakeLists.txt")) as f:
+        return re.search(r"project\([^)]*VERSION\s+([0-9.]+)", f.read()).group(1)
+
+
+def run(cmd, env=None, cwd=REPO_ROOT, timeout=60):
+    return subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          env=env, cwd=cwd, timeout=timeout)
+
+
+def write_executable(path, text):
+    with open(path, "w") as f:
+        f.write(textwrap.dedent(text))
+    os.chmod(path, os.stat(path).st_mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
+    return path
+
+
+class ScratchTestCase(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory(prefix="ofn-cli-test-")
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def assert_one_line_error(self, result, code, *fragments):
+        self.assertEqual(result.returncode, code, result.stdout + result.stderr)
+        message = result.stderr.strip()
+        self.assertEqual(len(message.splitlines()), 1, "not one line: %r" % result.stderr)
+        self.assertNotIn("Traceback", message)
+        self.assertNotIn("unbound variable", message)
+        for fragment in fragments:
+            self.assertIn(fragment, message)
+
+
+# ---------------------------------------------------------------------------
+# deploy/*.sh
+# ---------------------------------------------------------------------------
+
+class FlyUsageTest(ScratchTestCase):
+    FLY = os.path.join(DEPLOY, "fly.sh")
+
+    def test_help_is_a_usage_text(self):
+        result = run([self.FLY, "--help"])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue(result.stdout.startswith("usage: deploy/fly.sh "), result.stdout)
+        for option, default in (("--scenario FILE", "sim/scenarios/bench3.yaml"), ("--rtf X", "1.0"),
+                                ("--timeout S", "300"), ("--out DIR", "results/run-")):
+            line = next((l for l in result.stdout.splitlines() if l.strip().startswith(option)), "")
+            self.assertIn("(default: " + default, line, option)
+        self.assertIn("deploy/replay.sh latest", result.stdout)
+        self.assertFalse([l for l in result.stdout.splitlines() if l.startswith("#")],
+                         "raw comments in the help")
+
+    def test_option_without_value(self):
+        for option in ("--rtf", "--scenario", "--out", "--timeout"):
+            self.assert_one_line_error(run([self.FLY, option]), 2,
+                                       "fly.sh: error: %s needs a value" % option)
+
+    def test_unknown_option(self):
+        self.assert_one_line_error(run([self.FLY, "--speed", "2"]), 2, "unknown option '--speed'")
+
+    def test_bad_values(self):
+        self.assert_one_line_error(run([self.FLY, "--rtf", "0"]), 2, "--rtf must be a positive number")
+        self.assert_one_line_error(run([self.FLY, "--rtf", "fast"]), 2, "--rtf must be a positive number")
+        self.assert_one_line_error(run([self.FLY, "--timeout", "-5"]), 2, "--timeout must be")
+        self.assert_one_line_error(run([self.FLY, "--scenario", os.path.join(self.dir, "none.yaml")]),
+                                   2, "none.yaml' not found")
+
+
+class ReplayUsageTest(ScratchTestCase):
+    REPLAY = os.path.join(DEPLOY, "replay.sh")
+
+    def test_help(self):
+        result = run([self.REPLAY, "--help"])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue(result.stdout.startswith("usage: deploy/replay.sh LOGFILE"))
+        self.assertIn("results/*/latest_log", result.stdout)
+
+    def test_usage_errors(self):
+        log = os.path.join(self.dir, "flight.lcm")
+        with open(log, "wb") as f:
+            f.write(b"LCM")
+        empty = os.path.join(self.dir, "empty.lcm")
+        open(empty, "wb").close()
+        for args, fragment in (([log, "--speed"], "--speed needs a value"),
+                               ([log, "--lcm-url"], "--lcm-url needs a value"),
+                               ([log, "--channels"], "--channels needs a value"),
+                               ([log, "--rewind"], "unknown option '--rewind'"),
+                               ([], "missing LOGFILE"),
+                               ([log, log], "only one LOGFILE"),
+                               ([os.path.join(self.dir, "nope.lcm")], "nope.lcm' not found"),
+                               ([self.dir], "is not a regular file"),
+                               ([empty], "is empty"),
+                               ([log, "--speed", "0"], "--speed must be a positive number"),
+                               ([log, "--speed", "x2"], "--speed must be a positive number")):
+            self.assert_one_line_error(run([self.REPLAY] + args), 2, "replay.sh: error: ", fragment)
+
+    def test_missing_player_names_the_debian_package(self):
+        log = os.path.join(self.dir, "flight.lcm")
+        with open(log, "wb") as f:
+            f.write(b"LCM")
+        # A PATH with the shell tools the script uses, but no lcm-logplayer.
+        tools = os.path.join(self.dir, "tools")
+        os.mkdir(tools)
+        for tool in ("bash", "dirname", "head", "awk"):
+            os.symlink(shutil.which(tool), os.path.join(tools, tool))
+        result = run(["/bin/bash", self.REPLAY, log], env=dict(os.environ, PATH=tools))
+        self.assert_one_line_error(result, 1, "lcm-logplayer not found", "apt-get install liblcm-bin")
+        self.assertNotRegex(result.stderr, r"install lcm\b")
+
+
+class SpyAndNetnsUsageTest(ScratchTestCase):
+    def test_spy(self):
+        spy = os.path.join(DEPLOY, "spy.sh")
+        result = run([spy, "--help"])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue(result.stdout.startswith("usage: deploy/spy.sh"))
+        self.assert_one_line_error(run([spy, "--lcm-url"]), 2, "--lcm-url needs a URL")
+        self.assert_one_line_error(run([spy, "--verbose"]), 2, "unknown argument '--verbose'")
+
+    def test_netns(self):
+        netns = os.path.join(DEPLOY, "netns.sh")
+        result = run([netns, "--help"])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue(result.stdout.startswith("usage: deploy/netns.sh"))
+        self.assert_one_line_error(run([netns]), 2, "missing COMMAND")
+        self.assert_one_line_error(run([netns, "--fallback"]), 2, "missing COMMAND")
+
+
+class FlyThenReplayTest(ScratchTestCase):
+    """`make run` (deploy/fly.sh) then `deploy/replay.sh latest`, in a scratch
+    copy of the repository with stand-ins for LCM and the build."""
+
+    def setUp(self):
+        super().setUp()
+        self.repo = os.path.join(self.dir, "repo")
+        for sub in ("deploy", "build/bin", "services/tools", "config", "sim/scenarios"):
+            os.makedirs(os.path.join(self.repo, sub))
+        for name in ("fly.sh", "launch.py", "netns.sh", "replay.sh"):
+            shutil.copy2(os.path.join(DEPLOY, name), os.path.join(self.repo, "deploy", name))
+        with open(os.path.join(self.repo, "sim/scenarios/bench3.yaml"), "w") as f:
+            f.write("name: stand-in\n")
+        open(os.path.join(self.repo, "config/controller.yaml"), "w").close()
+        self.report_marker = os.path.join(self.dir, "report-ran")
+        write_executable(os.path.join(self.repo, "build/bin/ofn_flight_report"), """\
+            #!/bin/sh
+            touch %s
+            echo "report: $*"
+            """ % self.report_marker)
+        write_executable(os.path.join(self.repo, "services/tools/plot_flight.py"), """\
+            #!/usr/bin/python3
+            """)
+        self.fake_bin = os.path.join(self.dir, "fake-bin")
+        os.mkdir(self.fake_bin)
+        # lcm-logger: writes its file and runs until the launcher stops it.
+        write_executable(os.path.join(self.fake_bin, "lcm-logger"), """\
+            #!/bin/sh
+            for arg in "$@"; do out=$arg; done
+            printf 'LCM stand-in log\\n' > "$out"
+            trap 'exit 0' INT TERM
+            while :; do sleep 0.1; done
+            """)
+        # lcm-logplayer: says which file it was given.
+        write_executable(os.path.join(self.fake_bin, "lcm-logplayer"), """\
+            #!/bin/sh
+            for arg in "$@"; do last=$arg; done
+            echo "played $last"
+            """)
+        self.env = dict(os.environ, PATH=self.fake_bin + os.pathsep + os.environ.get("PATH", ""))
+
+    def write_table(self, service_command):
+        with open(os.path.join(self.repo, "deploy/processes.yaml"), "w") as f:
+            f.write(textwrap.dedent("""\
+                hosts:
+                  gcs: {cores: [0]}
+                processes:
+                  - name: service
+                    host: gcs
+                    core: 0
+                    command: %s
+                    restart: true
+                  - name: monitor
+                    host: gcs
+                    core: 0
+                    command: ["sleep", "1"]
+                    ends_run: true
+                """ % service_command))
+
+    def fly(self, *args):
+        # --host-network: the stand-ins send nothing, so no namespace is needed.
+        return run([os.path.join(self.repo, "deploy/fly.sh"), "--host-network", "--timeout", "30"]
+                   + list(args), env=self.env, cwd=self.repo, timeout=120)
+
+    def replay_latest(self):
+        return run([os.path.join(self.repo, "deploy/replay.sh"), "latest"], env=self.env,
+                   cwd=self.repo)
+
+    def test_replay_latest_plays_the_flight_of_fly_sh(self):
+        self.write_table('["sleep", "30"]')
+        flown = self.fly()
+        self.assertEqual(flown.returncode, 0, flown.stdout + flown.stderr)
+        self.assertIn("deploy/replay.sh latest", flown.stdout)
+        runs = [d for d in os.listdir(os.path.join(self.repo, "results")) if d.startswith("run-")]
+        self.assertEqual(len(runs), 1)
+        with open(os.path.join(self.repo, "results", runs[0], "latest_log")) as f:
+            log = f.read().strip()
+        self.assertTrue(os.path.isfile(log), log)
+
+        replayed = self.replay_latest()
+        self.assertEqual(replayed.returncode, 0, replayed.stdout + replayed.stderr)
+        self.assertIn("played " + log, replayed.stdout)
+
+        # A later flight of deploy/launch.py (results/latest_log) is newer.
+        time.sleep(1.1)
+        direct = os.path.join(self.repo, "results", "direct.lcm")
+        with open(direct, "w") as f:
+            f.write("LCM\n")
+        with open(os.path.join(self.repo, "results", "latest_log"), "w") as f:
+            f.write(direct + "\n")
+        self.assertIn("played " + direct, self.replay_latest().stdout)
+
+    def test_replay_latest_without_any_flight(self):
+        self.assert_one_line_error(self.replay_latest(), 2, "no flight recorded yet")
+
+    def test_fly_stops_on_a_configuration_error(self):
+        self.write_table('["/bin/sh", "-c", "echo bad config >&2; exit 2"]')
+        flown = self.fly()
+        self.assertEqual(flown.returncode, 2, flown.stdout + flown.stderr)
+        self.assertIn("configuration or usage error", flown.stderr)
+        self.assertFalse(os.path.exists(self.report_marker), "a report was made of no flight")
+
+
+# ---------------------------------------------------------------------------
+# bench/*.py
+# ---------------------------------------------------------------------------
+
+class BenchScriptTest(ScratchTestCase):
+    def setUp(self):
+        super().setUp()
+        # Stub packages that fail to import, first on the module path.
+        self.stubs = os.path.join(self.dir, "stubs")
+        for name in HIDDEN_MODULES:
+            os.makedirs(os.path.join(self.stubs, name))
+            with open(os.path.join(self.stubs, name, "__init__.py"), "w") as f:
+                f.write("raise ModuleNotFoundError(\"No module named '%s'\", name=%r)\n" % (name, name))
+        self.no_modules = dict(os.environ, PYTHONPATH=self.stubs)
+        # A build with an ofn_sim_runner that is never run.
+        self.build = os.path.join(self.dir, "build")
+        os.makedirs(os.path.join(self.build, "bin"))
+        write_executable(os.path.join(self.build, "bin", "ofn_sim_runner"), "#!/bin/sh\nexit 1\n")
+
+    def bench(self, script, *args, env=None):
+        return run([sys.executable, os.path.join(BENCH, script)] + list(args), env=env)
+
+    def test_stubs_hide_the_modules(self):
+        for name in HIDDEN_MODULES:
+            result = run([sys.executable, "-c", "import %s" % name], env=self.no_modules)
+            self.assertNotEqual(result.returncode, 0, name)
+
+    def test_help_and_version_without_numpy_matplotlib_yaml(self):
+        version = project_version()
+        for script in BENCH_SCRIPTS:
+            result = self.bench(script, "--help", env=self.no_modules)
+            self.assertEqual(result.returncode, 0, script + ": " + result.stderr)
+            self.assertTrue(result.stdout.startswith("usage: bench/" + script), result.stdout)
+            result = self.bench(script, "--version", env=self.no_modules)
+            self.assertEqual(result.returncode, 0, script + ": " + result.stderr)
+            self.assertEqual(result.stdout.strip(), "bench/%s %s" % (script, version))
+
+    def test_missing_module_at_use_time_is_one_line(self):
+        out = os.path.join(self.dir, "out")
+        result = self.bench("random_field.py", "--seed", "1", "--out", os.path.join(out, "f.yaml"),
+                            env=self.no_modules)
+        self.assert_one_line_error(result, 2, "bench/random_field.py: error:", "yaml",
+                                   "apt-get install python3-yaml")
+        results_dir = os.path.join(self.dir, "flight")
+        os.mkdir(results_dir)
+        with open(os.path.join(results_dir, "summary.json"), "w") as f:
+            f.write("{}\n")
+        with open(os.path.join(results_dir, "nav_state.csv"), "w") as f:
+            f.write("t,north,east,down\n0,0,0,0\n")
+        result = self.bench("campaign_report.py", results_dir, env=self.no_modules)
+        self.assert_one_line_error(result, 2, "numpy", "python3-numpy")
+        # Checked before any flight, not after hours of them.
+        for script in ("monte_carlo.py", "campaign.py"):
+            result = self.bench(script, "--build", self.build, "--out", out, "--quick",
+                                env=self.no_modules)
+            self.assert_one_line_error(result, 2, "bench/%s: error:" % script, "apt-get install")
+        self.assertFalse(os.path.exists(out), "work was started")
+
+    def test_usage_and_input_errors_are_one_line(self):
+        broken = os.path.join(self.dir, "broken.yaml")
+        with open(broken, "w") as f:
+            f.write("units: ft\nstart: [1, 2\n")
+        listed = os.path.join(self.dir, "list.yaml")
+        with open(listed, "w") as f:
+            f.write("- 1\n")
+        out = os.path.join(self.dir, "f.yaml")
+        cases = [
+            ("monte_carlo.py", ["--build", self.build, "--runs", "0"], "--runs and --jobs must be >= 1"),
+            ("monte_carlo.py", ["--build", self.build, "--seeds", "1,x"], "--seeds"),
+            ("monte_carlo.py", ["--build", os.path.join(self.dir, "none")], "no ofn_sim_runner"),
+            ("monte_carlo.py", ["--build", self.build, "--template", broken + ".missing"], "--template"),
+            ("monte_carlo.py", ["--build", self.build, "--config-dir", self.dir + "/none"], "--config-dir"),
+            ("monte_carlo.py", ["--jobs"], "expected one argument"),
+            ("campaign.py", ["--build", self.build, "--courses", "bench9"], "no scenario file"),
+            ("campaign.py", ["--build", self.build, "--rtf", "0"], "--rtf > 0"),
+            ("campaign.py", ["--fast"], "unrecognized arguments: --fast"),
+            ("random_field.py", [], "required"),
+            ("random_field.py", ["--seed", "one", "--out", out], "invalid int value"),
+            ("random_field.py", ["--seed", "1", "--out", out, "--template", broken + ".missing"],
+             "No such file"),
+            ("random_field.py", ["--seed", "1", "--out", out, "--template", broken], "not valid YAML: line 3"),
+            ("random_field.py", ["--seed", "1", "--out", out, "--template", listed], "not a scenario"),
+            ("random_field.py", ["--seed", "1", "--out", os.path.join(listed, "f.yaml")], "list.yaml"),
+            ("campaign_report.py", [], "required"),
+            ("campaign_report.py", [os.path.join(self.dir, "none")], "no folder"),
+            ("campaign_report.py", [self.dir], "no summary.json"),
+        ]
+        for script, args, fragment in cases:
+            with self.subTest(script=script, args=args):
+                result = self.bench(script, *args)
+                self.assert_one_line_error(result, 2, "bench/%s: error:" % script, fragment)
+                self.assertEqual(result.stdout, "")
+
+    def test_help_shows_every_default(self):
+        for script in BENCH_SCRIPTS:
+            module = load_module(os.path.join(BENCH, script))
+            for action in module.build_parser()._actions:
+                if action.dest in ("help", "version"):
+                    continue
+                with self.subTest(script=script, option=action.option_strings or action.dest):
+                    self.assertRegex(action.help or "", r"\((default: [^)]+|required)\)$")
+
+
+def load_module(path):
+    name = "ofn_cli_" + os.path.splitext(os.path.basename(path))[0]
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+# ---------------------------------------------------------------------------
+# Every help text
+# ---------------------------------------------------------------------------
+
+# Repository paths a help text names: dir/.../name.yaml|.py|.sh, relative.
+HELP_PATH_RE = re.compile(r"(?<![\w./*$<{-])((?:[\w.-]+/)+[\w.-]+\.(?:yaml|py|sh))(?![\w/])")
+
+
+class HelpExamplesTest(unittest.TestCase):
+    def test_files_named_in_help_texts_exist(self):
+        commands = [[sys.executable, os.path.join(DEPLOY, "launch.py"), "--help"]]
+        commands += [[os.path.join(DEPLOY, s), "--help"]
+                     for s in ("fly.sh", "replay.sh", "spy.sh", "netns.sh")]
+        commands += [[sys.executable, os.path.join(BENCH, s), "--help"] for s in BENCH_SCRIPTS]
+        for cmd in commands:
+            result = run(cmd)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            paths = HELP_PATH_RE.findall(result.stdout)
+            self.assertTrue(paths, "%s names no file" % cmd[-2])
+            for path in paths:
+                if any(part.isupper() for part in re.split(r"[/.-]", path)):
+                    continue  # a placeholder such as OUT/... or DIR/...
+                with self.subTest(help=os.path.basename(cmd[-2]), path=path):
+                    self.assertTrue(os.path.exists(os.path.join(REPO_ROOT, path)),
+                                    "%s --help names %s, which does not exist" % (cmd[-2], path))
+
+
+if __name__ == "__main__":
+    unittest.main()
