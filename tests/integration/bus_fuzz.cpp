@@ -2,9 +2,14 @@
 // type filled with NaN or with absurd sizes, and valid encodings with a
 // hostile int32 written over a random field: negative or huge array counts
 // and string lengths behind a valid fingerprint), then listens to the
-// heartbeats and reports each service's rejection counter. Exits 0 when
-// every service named on the command line is still alive and has rejected
-// something.
+// heartbeats and reports each service's rejection counter. Alongside the
+// garbage it sends well-formed forgeries stamped with the simulation's own
+// time, each of which a service must refuse: a SIM_CLOCK 1,000 s ahead, a
+// CONTROL_STATUS saying DONE mid-flight, a REF_TRAJ at five times the speed
+// limit and an ACTUATOR_CMD beyond the cyclic's range. (A forged MISSION
+// that the controller refuses would still be taken by the planners: only an
+// authenticated bus can stop that.) Exits 0 when every service named on the
+// command line is still alive and has rejected something.
 
 #include <chrono>
 #include <cmath>
@@ -49,11 +54,53 @@ std::vector<uint8_t> with_hostile_int32(const Msg& m, std::mt19937& rng) {
   return bytes;
 }
 
+/// The simulation time from SIM_CLOCK, ignoring this program's own forged
+/// stamps (multicast loops them back).
+void on_sim_clock(const lcm::ReceiveBuffer* rbuf, const std::string&, ofn::Utime* sim_now) {
+  ofn::sim_clock_t m;
+  if (m.decode(rbuf->data, 0, rbuf->data_size) != static_cast<int>(rbuf->data_size)) return;
+  if (*sim_now == INT64_MIN || (m.utime >= *sim_now && m.utime - *sim_now < 100 * 1000000LL))
+    *sim_now = m.utime;
+}
+
 void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string&,
                   std::map<std::string, ofn::heartbeat_t>* seen) {
   ofn::heartbeat_t hb;
   if (hb.decode(rbuf->data, 0, rbuf->data_size) == static_cast<int>(rbuf->data_size))
     (*seen)[hb.service] = hb;
+}
+
+/// Well-formed messages that pass validation and must still be refused.
+void publish_forgeries(lcm::LCM& lcm, ofn::Utime now) {
+  namespace ch = ofn::channels;
+  ofn::sim_clock_t clock{};
+  clock.utime = now + 1000 * 1000000LL;
+  clock.real_time_factor = 1.0;
+  lcm.publish(ch::kSimClock, &clock);
+
+  ofn::control_status_t done{};
+  done.utime = now;
+  done.mode = ofn::control_status_t::DONE;
+  done.mission_id = 1;
+  lcm.publish(ch::kControlStatus, &done);
+
+  ofn::ref_traj_t fast{};
+  fast.utime = now;
+  fast.t0_utime = now;
+  fast.frame = "NED";
+  fast.mode = ofn::ref_traj_t::AVOIDANCE;
+  fast.num_samples = 2;
+  fast.sample_time = {0.0, 2.0};
+  fast.position = {{0, 0, -6}, {30, 0, -6}};
+  fast.velocity = {{15, 0, 0}, {15, 0, 0}};
+  fast.acceleration = {{0, 0, 0}, {0, 0, 0}};
+  lcm.publish(ch::kRefTraj, &fast);
+
+  ofn::actuator_cmd_t cmd{};
+  cmd.utime = now;
+  cmd.collective = 0.1;
+  cmd.lon_cyclic = 0.9;
+  lcm.publish(ch::kActuatorCmd, &cmd);
 }
 
 }  // namespace
@@ -73,6 +120,8 @@ int main(int argc, char** argv) {
   if (!lcm.good()) return 2;
   std::map<std::string, ofn::heartbeat_t> seen;
   lcm.subscribeFunction("HEARTBEAT_.*", &on_heartbeat, &seen);
+  ofn::Utime sim_now = INT64_MIN;
+  lcm.subscribeFunction(ofn::channels::kSimClock, &on_sim_clock, &sim_now);
 
   namespace ch = ofn::channels;
   const std::vector<std::string> channels = {
@@ -121,6 +170,7 @@ int main(int argc, char** argv) {
     hostile(ch::kMission, mission);
     hostile(ch::kRefTraj, traj);
     hostile(ch::kControlStatus, status);
+    if (sim_now != INT64_MIN) publish_forgeries(lcm, sim_now);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
     while (lcm.handleTimeout(0) > 0) {
     }
