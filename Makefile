@@ -36,8 +36,9 @@ build: $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
 # The main job: the benchmark course flown by all services as separate processes.
+# HOSTS=3: on the gcs/onboard1/onboard2 split, three network namespaces on a bridge.
 run: deps build
-	deploy/fly.sh --scenario $(SCENARIO) --rtf $(RTF)
+	$(if $(filter-out 1 3,$(HOSTS)),$(error HOSTS=$(HOSTS): use HOSTS=3 for three hosts or leave it unset for one))deploy/$(if $(filter 3,$(HOSTS)),fly_three_hosts.sh,fly.sh) --scenario $(SCENARIO) --rtf $(RTF)
 
 test: deps build
 	cd $(BUILD) && ctest --output-on-failure -j 2 --timeout 600
