@@ -185,18 +185,19 @@ def _obstacle_plan(ax, summary, k):
 
 def _obstacle_extent(ob, axis):
     """(low, high) of the footprint along axis 0 (north) or 1 (east), metres."""
-    if ob.get("kind") in ("cylinder", "tree"):
-        r = 0.5 * float(ob["size"][axis])
-        return ob["center"][axis] - r, ob["center"][axis] + r
-    vals = [p[axis] for p in pf.obstacle_footprint(ob)]
-    return min(vals), max(vals)
+    return pf.obstacle_extent(ob)[axis]
 
 
-def _obstacle_elevation(ax, summary, k, axis):
+def _obstacle_elevation(ax, summary, k, axis, outline=False):
+    """Obstacles as bars standing on the ground; outlines only (drawn over
+    the LIDAR hits) when `outline`."""
+    style = dict(fill=False, ec=pf.OBSTACLE_STYLE["edgecolor"], lw=1.0, zorder=3) if outline \
+        else pf.OBSTACLE_STYLE
     for ob in summary.get("obstacles") or []:
         lo, hi = _obstacle_extent(ob, axis)
+        tree = ob.get("kind") == "tree" and not outline
         ax.add_patch(Rectangle((lo * k, 0), (hi - lo) * k, float(ob.get("height", 0)) * k,
-                               hatch="xx" if ob.get("kind") == "tree" else None, **pf.OBSTACLE_STYLE))
+                               hatch="xx" if tree else None, **style))
 
 
 def _flown_and_baseline(ax, nav, base, k, xcol, ycol, ysign):
@@ -204,21 +205,18 @@ def _flown_and_baseline(ax, nav, base, k, xcol, ycol, ysign):
         ax.plot(pf.col(base, xcol) * k, ysign * pf.col(base, ycol) * k, "--", color="k", lw=1.2,
                 label="time-optimal baseline")
     ax.plot(pf.col(nav, xcol) * k, ysign * pf.col(nav, ycol) * k, "-", color="tab:blue", lw=1.6,
-            label="flown")
+            label="flown", zorder=4)
 
 
 def _subsample(data, limit):
-    n = pf.nrows(data)
-    if n <= limit:
-        return data
-    idx = np.linspace(0, n - 1, limit).astype(int)
-    return {c: v[idx] for c, v in data.items()}
+    return pf.subsample(data, limit)
 
 
-def course_figure(run_dir, out_png, title=None, baseline_dir=None, tree_views=False):
-    """The paper-style figure of one flight: top view, altitude, speed, acceleration
-    (commanded vs actual) and, for sensor-in-the-loop courses, front and side
-    views with the LIDAR hits. Returns out_png, or None when the flight left no data."""
+def course_figure_of(run_dir, title=None, baseline_dir=None, tree_views=False):
+    """The paper-style figure of one flight as a Figure (see course_figure);
+    None when the flight left no data. Axes are named by their label: top
+    view, altitude, speed, acceleration, clearance and, with tree_views,
+    front view and side view."""
     summary = read_json(os.path.join(run_dir, "summary.json"))
     if summary is None or not os.path.isfile(os.path.join(run_dir, "nav_state.csv")):
         return None
@@ -234,26 +232,37 @@ def course_figure(run_dir, out_png, title=None, baseline_dir=None, tree_views=Fa
     gate_times = [(summary.get("gate_start_t"), "start"), (summary.get("gate_finish_t"), "finish")]
     shift = baseline_time_shift(summary, base)
 
-    rows = 4 if tree_views else 3
-    fig = plt.figure(figsize=(12, 3.4 * rows + 1))
-    gs = fig.add_gridspec(rows, 2, height_ratios=[1.2, 1.0, 1.1] + ([1.3] if tree_views else []))
-    ax_top = fig.add_subplot(gs[0, :])
-    ax_alt = fig.add_subplot(gs[1, :], sharex=ax_top)
-    ax_spd = fig.add_subplot(gs[2, 0])
-    ax_acc = fig.add_subplot(gs[2, 1], sharex=ax_spd)
+    # Framed on the flown path, the baseline and the obstacles, at equal
+    # scale; the top view's height follows the frame's shape.
+    frame = pf.frame_of([(pf.col(nav, "north") * k, pf.col(nav, "east") * k),
+                         (pf.col(base, "north") * k, pf.col(base, "east") * k),
+                         pf.obstacle_points(summary, k)])
+    top_h = 3.4
+    if frame is not None:
+        # The axes' height, plus the room of their title and tick labels.
+        top_h = float(np.clip(10.8 * (frame[3] - frame[2]) / (frame[1] - frame[0]), 1.6, 7.0)) + 0.9
+    heights = [top_h, 2.8, 3.2] + ([3.8] if tree_views else [])
+    rows = len(heights)
+    fig = plt.figure(figsize=(12, sum(heights) + 1.6))
+    gs = fig.add_gridspec(rows, 1, height_ratios=heights)
+    ax_top = fig.add_subplot(gs[0], label="top view")
+    ax_alt = fig.add_subplot(gs[1], sharex=ax_top, label="altitude")
+    row = gs[2].subgridspec(1, 3, wspace=0.3)
+    ax_spd = fig.add_subplot(row[0], label="speed")
+    ax_acc = fig.add_subplot(row[1], sharex=ax_spd, label="acceleration")
+    ax_clr = fig.add_subplot(row[2], sharex=ax_spd, label="clearance")
 
     _obstacle_plan(ax_top, summary, k)
     _flown_and_baseline(ax_top, nav, base, k, "north", "east", 1.0)
     pf.draw_gates(ax_top, gates)
-    ax_top.set_aspect("equal", adjustable="datalim")
-    ax_top.autoscale_view()
     ax_top.set(xlabel="x [%s]" % unit, ylabel="y [%s]" % unit, title="trajectory, top view")
 
     _obstacle_elevation(ax_alt, summary, k, 0)
     _flown_and_baseline(ax_alt, nav, base, k, "north", "down", -1.0)
     pf.draw_gates(ax_alt, gates, labels=False)
-    ax_alt.autoscale_view()
-    ax_alt.set_ylim(bottom=0.0)
+    heights_h = [float(ob.get("height", 0)) * k for ob in summary.get("obstacles") or []]
+    heights_h += [pf.finite_max(-pf.col(d, "down") * k) for d in (nav, base) if d is not None]
+    ax_alt.set_ylim(0.0, 1.15 * max(heights_h + [1.0]))
     ax_alt.set(xlabel="x [%s]" % unit, ylabel="h [%s]" % unit, title="altitude")
 
     speed = np.sqrt(pf.col(nav, "vn") ** 2 + pf.col(nav, "ve") ** 2 + pf.col(nav, "vd") ** 2)
@@ -279,41 +288,73 @@ def course_figure(run_dir, out_png, title=None, baseline_dir=None, tree_views=Fa
         smooth = np.convolve(a_nav, np.ones(width) / width, mode="same")
         ax_acc.plot(t_nav, smooth, color="tab:blue", lw=1.2, label="actual, %.1f s mean" % SMOOTHING_S)
     if ctl is not None:
-        ax_acc.plot(pf.col(ctl, "t"), magnitude(ctl, "ref_") * k, color="tab:red", lw=1.2,
-                    label="commanded")
+        # The reference acceleration (what the summary calls commanded), only
+        # while the controller flies a plan: not a hold's command.
+        pf.shade_idle(ax_acc, pf.idle_spans(ctl))
+        ax_acc.plot(pf.col(ctl, "t"), pf.while_flying(ctl, magnitude(ctl, "ref_")) * k,
+                    color="tab:red", lw=1.2, label="reference (commanded)", gid="reference")
     if lim.get("max_accel") is not None:
         ax_acc.axhline(lim["max_accel"] * k, color="red", ls="--", lw=1, label="limit")
         ax_acc.set_ylim(0.0, 2.5 * lim["max_accel"] * k)
     pf.draw_gates(ax_acc, gate_times, labels=False)
     ax_acc.set(xlabel="t [s]", ylabel="|a| [%s/s²]" % unit, title="acceleration")
 
-    axes = [ax_top, ax_alt, ax_spd, ax_acc]
+    pf.panel_clearance(ax_clr, k, unit, pf.true_clearance(nav, summary), summary, gate_times)
+    ax_clr.set(xlabel="t [s]", ylabel="clearance [%s]" % unit, title="least true clearance")
+
+    axes = [ax_top, ax_alt, ax_spd, ax_acc, ax_clr]
     if tree_views:
         scan = _subsample(load_csv(run_dir, "scan_points.csv"), MAX_SCAN_POINTS)
+        row = gs[3].subgridspec(1, 2, wspace=0.2)
         for col_idx, (xcol, axis, name) in enumerate((("east", 1, "front view (y-h)"),
                                                      ("north", 0, "side view (x-h)"))):
-            ax = fig.add_subplot(gs[3, col_idx])
-            _obstacle_elevation(ax, summary, k, axis)
+            ax = fig.add_subplot(row[col_idx], label=name.split(" (")[0])
+            # The hits are what these views show: obstacle outlines over them,
+            # so that neither buries the other.
+            _obstacle_elevation(ax, summary, k, axis, outline=True)
             if scan is not None and pf.nrows(scan):
-                ax.plot(scan[xcol] * k, -scan["down"] * k, ".", ms=1, color="0.45", label="LIDAR hits")
+                ax.plot(scan[xcol] * k, -scan["down"] * k, ls="none", marker=".", ms=1,
+                        color="0.45", alpha=0.6, zorder=1, rasterized=True, label="LIDAR hits")
             ax.plot(pf.col(nav, xcol) * k, -pf.col(nav, "down") * k, "-", color="tab:blue", lw=1.6,
-                    label="flown")
+                    label="flown", zorder=4)
             ax.set(xlabel="%s [%s]" % ("y" if axis else "x", unit), ylabel="h [%s]" % unit, title=name)
             ax.set_ylim(bottom=0.0)
-            if axis == 0:
-                ax.set_xlim(*ax_top.get_xlim())
             axes.append(ax)
     for ax in axes:
         ax.grid(alpha=0.3)
         ax.tick_params(labelsize=8)
-        ax.legend(fontsize=7, loc="best", framealpha=0.7)
+        if ax is not ax_clr:  # the clearance panel has its legend
+            ax.legend(fontsize=7, loc="best", framealpha=0.7)
 
-    head = title or str(summary.get("scenario", os.path.basename(run_dir)))
-    if summary.get("gate_to_gate") is not None:
-        head += "   gate-to-gate %.1f s" % summary["gate_to_gate"]
-    fig.suptitle(head, fontsize=13)
+    head, reason = pf.verdict_title(summary, title)
+    fig_h = fig.get_size_inches()[1]
+    outcome, _ = pf.verdict_of(summary)
+    fig.suptitle(head + ("\n" + reason if reason else ""), fontsize=13, y=1 - 0.1 / fig_h,
+                 va="top", color="firebrick" if outcome == "failure" else "black")
     fig.text(0.99, 0.005, pf.FOOTER, ha="right", va="bottom", fontsize=7, color="0.4")
-    fig.tight_layout(rect=(0, 0.015, 1, 0.97))
+    # tight_layout makes room for the suptitle itself.
+    fig.tight_layout(rect=(0, 0.15 / fig_h, 1, 1 - 0.1 / fig_h))
+    pf.fit_equal(ax_top, frame)  # after the layout: it needs the axes' box
+    if tree_views:
+        # Framed like the top view, not on the ground hits.
+        front, side = axes[-2:]
+        front.set_xlim(*ax_top.get_ylim())
+        side.set_xlim(*ax_top.get_xlim())
+        top = 1.15 * max(heights_h + [1.0])
+        for ax in (front, side):
+            ax.set_ylim(0.0, top)
+    return fig
+
+
+def course_figure(run_dir, out_png, title=None, baseline_dir=None, tree_views=False):
+    """The paper-style figure of one flight: top view, altitude, speed,
+    acceleration (the reference, i.e. commanded, against the actual), the
+    least true clearance and, for sensor-in-the-loop courses, front and side
+    views with the LIDAR hits; the verdict in the title. Returns out_png, or
+    None when the flight left no data."""
+    fig = course_figure_of(run_dir, title=title, baseline_dir=baseline_dir, tree_views=tree_views)
+    if fig is None:
+        return None
     fig.savefig(out_png, dpi=100)
     plt.close(fig)
     return out_png
