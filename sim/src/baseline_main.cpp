@@ -17,6 +17,7 @@
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/common/service_main.hpp"
 #include "ofn/sim/time_optimal.hpp"
 
 namespace {
@@ -149,12 +150,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-solve-time", settings.max_solve_time, "s of computation per initial guess")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
   ofn::Scenario scenario;
   try {
     scenario = ofn::load_scenario(scenario_path);

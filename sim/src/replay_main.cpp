@@ -45,12 +45,7 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "services' log level")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.failure_message(CLI::FailureMessage::help);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // A bad command line is bad input like a bad log: exit 2, not CLI11's own codes.
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_replay", [&]() -> int {
     ofn::set_log_level(log_level);

@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
       "when it is failure; without --out (no report, no verdict), 0 when the vehicle "
       "arrived and 1 when not; 2 for bad arguments, config or scenario.");
   app.failure_message(CLI::FailureMessage::help);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_sim_runner", [&]() -> int {
     ofn::set_log_level(log_level);

@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Bad command lines and files get a clear message and a non-zero exit, never a crash.
+# Bad command lines and files get a clear message and exit code 2 (an input
+# error, which the launcher never restarts), never a crash.
 source "$(dirname "$0")/common.sh"
 expect_error() {  # expect_error "pattern" command...
   local pattern=$1; shift
   set +e; "$@" > "$WORK/out.txt" 2>&1; local code=$?; set -e
-  [[ $code -ne 0 && $code -lt 128 ]] || { cat "$WORK/out.txt"; fail "'$*' exited $code"; }
+  [[ $code -eq 2 ]] || { cat "$WORK/out.txt"; fail "'$*' exited $code, not 2"; }
   grep -q -- "$pattern" "$WORK/out.txt" || { cat "$WORK/out.txt"; fail "'$*' did not say '$pattern'"; }
 }
 expect_error "Usage" "$BIN/ofn_controller" --no-such-flag
+expect_error "Usage" "$BIN/ofn_flight_monitor" --timeout -1
+expect_error "Usage" "$BIN/ofn_sim_runner" --max-time abc
 expect_error "Usage" "$BIN/ofn_vehicle_sim" --scenario
 expect_error "scenario is required\|--scenario is required" "$BIN/ofn_mission_uplink"
 cat > "$WORK/bad.yaml" <<'YAML'

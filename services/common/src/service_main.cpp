@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <iostream>
@@ -75,7 +76,10 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
     nodes.front()->subscribe<sim_clock_t>(
         channels::kSimClock,
         [follower, guard, nodes](const sim_clock_t& m) {
-          switch (guard->offer(m.utime)) {
+          const Utime arrival = std::chrono::duration_cast<std::chrono::microseconds>(
+                                    std::chrono::steady_clock::now().time_since_epoch())
+                                    .count();
+          switch (guard->offer(m.utime, arrival)) {
             case SimClockGuard::Verdict::kAccepted:
               follower->update(m.utime);
               break;
@@ -121,15 +125,27 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
   return 0;
 }
 
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : kExitInputError;
+  }
+  return std::nullopt;
+}
+
 int guarded_main(const std::string& program, const std::function<int()>& body) {
   try {
     return body();
   } catch (const ConfigError& e) {
     std::cerr << program << ": configuration error: " << e.what() << "\n";
-    return 2;
+    return kExitInputError;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << program << ": " << e.what() << "\n";
+    return kExitInputError;
   } catch (const std::exception& e) {
     std::cerr << program << ": " << e.what() << "\n";
-    return 2;
+    return kExitRuntimeError;
   }
 }
 

@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn controller: trajectory follower and waypoint guidance"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_controller", [&] {
     auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")

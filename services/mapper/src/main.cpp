@@ -9,7 +9,7 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn mapper: obstacle grid (OBSTACLE_GRID) and cuboid database (CUBOIDS)"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_mapper", [&] {
     auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")

@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
   std::string scenario_path;
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")->required();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_mission_uplink", [&] {
     auto lcm = ofn::open_lcm(options);

@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")
       ->required()
       ->check(CLI::ExistingFile);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_obstacle_injector", [&] {
     auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")

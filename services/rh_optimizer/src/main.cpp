@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn rh_optimizer: B-spline trajectory optimisation in sensor range (REF_TRAJ)"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_rh_optimizer", [&] {
     auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")

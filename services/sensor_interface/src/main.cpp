@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn sensor_interface: LIDAR scans to world-frame points"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_sensor_interface", [&] {
     auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
       "Exit code: 0 when the flight's outcome is success or safe_stop, 1 when it is "
       "failure, 2 for bad arguments or an unreadable log.");
   app.failure_message(CLI::FailureMessage::help);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
   return ofn::guarded_main("ofn_flight_report", [&] {
     std::optional<ofn::Scenario> scenario;
     if (!scenario_path.empty()) scenario = ofn::load_scenario(scenario_path);

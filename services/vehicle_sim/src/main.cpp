@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")->required();
   app.add_option("--real-time-factor", real_time_factor, "simulation speed, 1 = real time")
       ->check(CLI::Range(0.01, 1000.0));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_vehicle_sim", [&] {
     const ofn::Scenario scenario = ofn::load_scenario(scenario_path);

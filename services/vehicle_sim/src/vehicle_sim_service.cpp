@@ -99,8 +99,8 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
   const TrimResult t =
       trim(vehicle_.model(), scenario.start_velocity, scenario.start_heading, scenario.wind);
   if (!t.converged)
-    throw std::runtime_error("no trim for the start state of " + scenario.file +
-                             " (speed beyond the airframe's envelope?)");
+    throw ConfigError("no trim for the start state of " + scenario.file +
+                      " (speed beyond the airframe's envelope?)");
   start_state_ = t.state;
   start_state_.position = scenario.start_position;
   trim_controls_ = t.controls;

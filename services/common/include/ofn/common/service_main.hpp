@@ -4,6 +4,7 @@
 // any) LCM URL until SIGINT/SIGTERM.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,8 +44,21 @@ std::unique_ptr<Clock> make_clock(const std::string& kind);
 int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
               const std::function<bool()>& keep_running = {});
 
-/// Wraps a service main so that configuration errors and other exceptions
-/// end the process with a clear message and exit code 2 instead of a crash.
+/// Exit codes of every program: 2 for a usage or input error (bad command
+/// line, configuration or scenario), which a restart cannot mend; 1 for a
+/// failure at run time (the bus cannot be opened, an unexpected exception),
+/// which a restart may.
+constexpr int kExitInputError = 2;
+constexpr int kExitRuntimeError = 1;
+
+/// Parses the command line. Returns the exit code to end with: 0 after
+/// --help, kExitInputError after a usage error (CLI11 has printed it, not
+/// its own codes); nullopt to go on.
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv);
+
+/// Wraps a program's main so that exceptions end the process with a clear
+/// message instead of a crash: kExitInputError for a ConfigError or an
+/// invalid argument, kExitRuntimeError for anything else.
 int guarded_main(const std::string& program, const std::function<int()>& body);
 
 }  // namespace ofn
