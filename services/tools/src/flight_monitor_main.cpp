@@ -24,15 +24,15 @@ int main(int argc, char** argv) {
   ofn::CommonOptions options;
   double timeout = 300.0, report_period = 5.0, linger = 1.0;
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
-  app.add_option("--timeout", timeout, "give up after this many wall seconds")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--timeout", timeout, "give up after this many wall seconds (0: never)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--every", report_period, "seconds of flight time between progress lines")
       ->check(CLI::PositiveNumber);
   app.add_option("--linger", linger,
                  "seconds of flight time over which every status must say DONE, with the "
                  "vehicle at the last waypoint, before the flight counts as arrived")
       ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_flight_monitor", [&] {
     auto lcm = ofn::open_lcm(options);
@@ -53,13 +53,13 @@ int main(int argc, char** argv) {
         [&](const ofn::mission_t& m) {
           if (m.waypoints.empty()) return;
           const auto& last = m.waypoints.back();
-          arrival.set_goal(ofn::to_vec3(last.position), last.capture_radius);
+          arrival.set_goal(m.mission_id, ofn::to_vec3(last.position), last.capture_radius);
         },
         ofn::SubscribeOptions{0.0, 0.0});
     node.subscribe<ofn::control_status_t>(
         ofn::channels::kControlStatus, [&](const ofn::control_status_t& m) {
           const bool had_arrived = arrival.arrived_at().has_value();
-          arrival.on_status(m.utime, m.mode == ofn::control_status_t::DONE);
+          arrival.on_status(m.utime, m.mode == ofn::control_status_t::DONE, m.mission_id);
           if (!had_arrived && arrival.arrived_at())
             std::cout << "monitor: arrived at the last waypoint at t="
                       << ofn::to_seconds(*arrival.arrived_at()) << " s" << std::endl;
@@ -93,8 +93,8 @@ int main(int argc, char** argv) {
     bool timed_out = false;
     ofn::run_nodes(*lcm, *clock, {&node}, [&] {
       if (arrival.arrived_at()) return false;
-      timed_out =
-          std::chrono::steady_clock::now() - wall_start > std::chrono::duration<double>(timeout);
+      timed_out = timeout > 0 && std::chrono::steady_clock::now() - wall_start >
+                                     std::chrono::duration<double>(timeout);
       return !timed_out;
     });
     if (timed_out) {
