@@ -83,6 +83,22 @@ TEST(CommandGate, APlanThatLeavesTheEnvelopeAnywhereIsRefused) {
       gate.check_plan({0.0, 0.5}, {fine, at(Vec3(2500, 0, -6), Vec3::Zero(), Vec3::Zero())}, l));
 }
 
+TEST(CommandGate, OnlyThePresentAndTheFutureOfAPlanAreChecked) {
+  // A plan started on a vehicle a little over the limit, 0.5 s ago: its past
+  // is not checked, as the optimiser's commit gate does not check it.
+  const CommandGate gate;
+  const Limits l = course_limits();
+  const std::vector<double> times{0.0, 0.2, 0.4, 0.6, 0.8};
+  std::vector<Reference> samples(5, at(Vec3(0, 0, -6), Vec3(3, 0, 0), Vec3::Zero()));
+  samples[0].velocity.x() = 1.05 * l.max_speed;
+  EXPECT_TRUE(gate.check_plan(times, samples, l, 0.0));
+  EXPECT_TRUE(gate.check_plan(times, samples, l, 0.1));  // interpolated from it now
+  EXPECT_FALSE(gate.check_plan(times, samples, l, 0.5));
+  // The last sample is the plan's end: never past.
+  samples.back().velocity.x() = 1.05 * l.max_speed;
+  EXPECT_TRUE(gate.check_plan(times, samples, l, 5.0));
+}
+
 TEST(CommandGate, ClampsAReferenceIntoTheEnvelopeAndTheFence) {
   const CommandGate gate;
   const Limits l = course_limits();

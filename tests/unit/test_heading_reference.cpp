@@ -79,6 +79,23 @@ TEST(PathHeading, NothingToFaceAlongAVerticalLegOrASlowReference) {
   EXPECT_EQ(*fast, Vec3(3.0, -4.0, 0.0));
 }
 
+TEST(PathHeading, FacesWhereThePlanIsGoingNotOnlyWhereItGoesNow) {
+  // Flying north, the plan turns east: the direction faced already leans
+  // into the turn.
+  const Vec3 here(0, 0, -30), velocity(3, 0, 0), ahead(8, 4, -30);
+  const auto facing = facing_ahead(here, velocity, ahead, 1.0);
+  ASSERT_TRUE(facing);
+  EXPECT_NEAR(std::atan2(facing->y(), facing->x()), std::atan2(4.0, 8.0), 1e-12);
+  // Without a point ahead (a plan that ends now), along the velocity.
+  const auto along = facing_ahead(here, velocity, std::nullopt, 1.0);
+  ASSERT_TRUE(along);
+  EXPECT_EQ(*along, velocity);
+  // A point ahead less than a metre away points nowhere useful.
+  EXPECT_EQ(*facing_ahead(here, velocity, Vec3(0.5, 0.5, -30), 1.0), velocity);
+  // Slow: the heading holds, wherever the plan goes.
+  EXPECT_FALSE(facing_ahead(here, Vec3(0.5, 0, 0), ahead, 1.0));
+}
+
 TEST(YawSweepOffset, StartsAtRestAndReachesTheFullSweepAfterOnePeriod) {
   YawSweep sweep;
   sweep.frequency = 0.2;

@@ -65,10 +65,11 @@ std::optional<std::string> CommandGate::check_mission(
 
 std::optional<std::string> CommandGate::check_plan(const std::vector<double>& times,
                                                    const std::vector<Reference>& samples,
-                                                   const Limits& limits) const {
+                                                   const Limits& limits, double from) const {
   if (times.size() != samples.size())
     throw std::invalid_argument("command gate: one time per plan sample");
   for (size_t k = 0; k < samples.size(); ++k) {
+    if (k + 1 < samples.size() && times[k + 1] <= from) continue;  // past
     const Reference& r = samples[k];
     if (!inside_fence(r.position))
       return format("leaves the geofence at %.2f s (%.0f m north)", times[k], r.position.x());

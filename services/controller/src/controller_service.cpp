@@ -135,6 +135,7 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.heading.max_rate =
       deg2rad(heading.number_in("max_rate_deg_s", rad2deg(c.heading.max_rate), 1.0, 360.0));
   c.heading.min_speed = heading.number_in("min_speed", c.heading.min_speed, 0.0, 20.0);
+  c.heading.look_ahead = heading.number_in("look_ahead", c.heading.look_ahead, 0.0, 20.0);
   heading.finish();
   YamlReader nominal = r.child("nominal_airframe");
   c.nominal.mass = nominal.number_in("mass", c.nominal.mass, 1.0, 1e4);
@@ -221,7 +222,8 @@ void ControllerService::on_ref_traj(const ref_traj_t& m) {
       samples[k].velocity = vec(m.velocity[k]);
       samples[k].acceleration = vec(m.acceleration[k]);
     }
-    if (const auto why = gate_.check_plan(times, samples, flight_limits())) {
+    const double present = to_seconds(std::max(node_.now(), m.t0_utime) - m.t0_utime);
+    if (const auto why = gate_.check_plan(times, samples, flight_limits(), present)) {
       node_.reject(channels::kRefTraj, "plan refused: " + *why);
       return;
     }
@@ -324,6 +326,10 @@ void ControllerService::control_step() {
                           limits_from(mission_->limits), x.position, x.velocity);
     mission_pending_ = false;
   }
+  // The governor holds the speed within half the stated 2 % margin.
+  const Limits limits = flight_limits();
+  const double governed = 1.0 + 0.5 * config_.gate.tolerance;
+  controller_.set_speed_limits(governed * limits.max_speed, governed * limits.max_vertical_speed);
 
   const int8_t previous = mode_;
   std::optional<Reference> traj_ref;
@@ -340,9 +346,19 @@ void ControllerService::control_step() {
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;
-    facing = ref_traj_->mode == ref_traj_t::LOOK_AROUND
-                 ? std::optional<Vec3>(look_around_facing(path_heading_.yaw()))
-                 : facing_along(ref.velocity, config_.heading.min_speed);
+    if (ref_traj_->mode == ref_traj_t::LOOK_AROUND) {
+      facing = look_around_facing(path_heading_.yaw());
+    } else {
+      // Where the plan will be look_ahead seconds on (or at its end).
+      std::optional<Vec3> ahead;
+      if (config_.heading.look_ahead > 0 && !ref_traj_->sample_time.empty()) {
+        const Utime end = ref_traj_->t0_utime + to_utime(ref_traj_->sample_time.back());
+        const auto later =
+            sample_ref_traj(*ref_traj_, std::min(end, now + to_utime(config_.heading.look_ahead)));
+        if (later) ahead = later->position;
+      }
+      facing = facing_ahead(ref.position, ref.velocity, ahead, config_.heading.min_speed);
+    }
   } else if (selector_.avoiding()) {
     // The plan went stale mid-avoidance: its stop, then the hover.
     if (!selector_.stopping())

@@ -24,6 +24,17 @@ std::optional<Vec3> facing_along(const Vec3& direction, double min_horizontal) {
   return std::nullopt;
 }
 
+std::optional<Vec3> facing_ahead(const Vec3& here, const Vec3& velocity,
+                                 const std::optional<Vec3>& ahead, double min_speed) {
+  if (std::hypot(velocity.x(), velocity.y()) <= min_speed) return std::nullopt;
+  if (ahead) {
+    const Vec3 d = *ahead - here;
+    // Ahead by less than a metre (a plan about to end) points nowhere useful.
+    if (std::hypot(d.x(), d.y()) > 1.0) return d;
+  }
+  return velocity;
+}
+
 Vec3 look_around_facing(double yaw) {
   const double ahead = yaw + 0.5 * kPi;
   return Vec3(std::cos(ahead), std::sin(ahead), 0.0);

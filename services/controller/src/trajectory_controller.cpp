@@ -84,6 +84,30 @@ Vec3 TrajectoryController::angular_accel_for(const vehicle::Controls& c, double 
   return (moment - w.cross(p.inertia.cwiseProduct(w))).cwiseQuotient(p.inertia);
 }
 
+void TrajectoryController::set_speed_limits(double max_speed, double max_vertical_speed) {
+  governed_speed_ = std::isfinite(max_speed) ? std::max(0.0, max_speed) : 0.0;
+  governed_vertical_speed_ =
+      std::isfinite(max_vertical_speed) ? std::max(0.0, max_vertical_speed) : 0.0;
+}
+
+Vec3 TrajectoryController::govern_speed(const Vec3& accel, const Vec3& velocity) const {
+  Vec3 a = accel;
+  const double speed = velocity.norm();
+  if (governed_speed_ > 0 && speed > 1e-6) {
+    const Vec3 along = velocity / speed;
+    const double cap = gains_.velocity.x() * (governed_speed_ - speed);
+    const double excess = a.dot(along) - cap;
+    if (excess > 0) a -= excess * along;
+  }
+  if (governed_vertical_speed_ > 0) {
+    const double climb = std::abs(velocity.z());
+    const double sign = velocity.z() >= 0 ? 1.0 : -1.0;
+    const double cap = gains_.velocity.z() * (governed_vertical_speed_ - climb);
+    if (sign * a.z() > cap) a.z() = sign * cap;
+  }
+  return a;
+}
+
 ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEstimate& x,
                                          double dt) {
   const auto& p = model_.params();
@@ -133,11 +157,11 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   ad.outer_error_norm = std::hypot(ad.position_error.norm(), ad.velocity_error.norm());
   out.adaptive_accel = adaptive_->outer_output(ad);
   const Vec3 accel_wanted = ad.pseudo_accel - out.adaptive_accel;
-  Vec3 accel = accel_wanted;
+  Vec3 accel = govern_speed(accel_wanted, x.velocity);
   const Vec3 horizontal = clamp_norm(Vec3(accel.x(), accel.y(), 0.0), g.max_horizontal_accel);
   const double vertical = std::clamp(accel.z(), -g.max_vertical_accel, g.max_vertical_accel);
-  out.saturated =
-      (horizontal - Vec3(accel.x(), accel.y(), 0.0)).norm() > 1e-9 || vertical != accel.z();
+  out.saturated = (horizontal - Vec3(accel.x(), accel.y(), 0.0)).norm() > 1e-9 ||
+                  vertical != accel.z() || (accel - accel_wanted).norm() > 1e-9;
   accel = Vec3(horizontal.x(), horizontal.y(), vertical);
   out.commanded_accel = accel;
 

@@ -50,10 +50,14 @@ class CommandGate {
   std::optional<std::string> check_mission(const Limits& limits,
                                            const std::vector<Waypoint>& waypoints) const;
 
-  /// Why a plan sampled at `times` (s) is refused under `limits`, or nullopt.
+  /// Why a plan sampled at `times` (s) is refused under `limits`, or
+  /// nullopt. Samples wholly before `from` (s, the present on the plan's
+  /// time) are past: the last of them, which the present is interpolated
+  /// from, is checked, earlier ones are not, as the RH optimiser's commit
+  /// gate checks from the present on.
   std::optional<std::string> check_plan(const std::vector<double>& times,
-                                        const std::vector<Reference>& samples,
-                                        const Limits& limits) const;
+                                        const std::vector<Reference>& samples, const Limits& limits,
+                                        double from = 0.0) const;
 
   /// `reference` inside the fence and the envelope of `limits` (plus the
   /// tolerance); `clamped` says whether anything was changed.

@@ -28,6 +28,11 @@ struct YawSweep {
 struct PathHeading {
   double max_rate = deg2rad(30);  // rad/s the path heading turns at most
   double min_speed = 1.0;         // m/s of reference velocity below which it holds
+  /// s ahead along a trajectory the vehicle faces: the scanner looks where
+  /// the plan is going, not only where it goes now, so that the space a
+  /// turning plan (and its stops) will enter has been seen before it gets
+  /// there. 0 faces along the velocity.
+  double look_ahead = 3.0;
 };
 
 /// The path heading, turned toward the direction to face by at most
@@ -62,6 +67,13 @@ constexpr double kMinLegHorizontal = 0.2;
 /// `min_horizontal`, else none (the heading holds): a vertical leg, or a
 /// reference velocity too slow to point anywhere.
 std::optional<Vec3> facing_along(const Vec3& direction, double min_horizontal);
+
+/// The direction to face along a trajectory: toward `ahead` (the reference's
+/// position look_ahead seconds on, where the plan covers it) from `here`,
+/// or along `velocity` without one; none when the reference is slower than
+/// `min_speed` (the heading holds).
+std::optional<Vec3> facing_ahead(const Vec3& here, const Vec3& velocity,
+                                 const std::optional<Vec3>& ahead, double min_speed);
 
 /// The direction to face for a look-around: a quarter turn to the right of
 /// `yaw`, so that the path heading, always turning toward it, turns at its

@@ -126,6 +126,15 @@ class TrajectoryController {
   ControlOutput step(const Reference& ref, const VehicleEstimate& x, double dt);
   /// Forgets integrators and adaptation (mode changes, restarts).
   void reset();
+  /// The speed governor: the outer loop never asks for more acceleration
+  /// along the velocity than the velocity gain times what is left to
+  /// `max_speed` (m/s, the 3-D speed) and likewise for `max_vertical_speed`
+  /// (m/s, up or down), so that neither the reference model catching up with
+  /// a plan it lags nor the feedback on a position error drives the vehicle
+  /// beyond the limits, whatever the plan. Near and below them it acts as a
+  /// velocity loop saturated at the limit; far below it does nothing.
+  /// Zero turns a limit off (the default).
+  void set_speed_limits(double max_speed, double max_vertical_speed);
   /// Level-attitude hover command, the safe output when inputs are bad.
   vehicle::Controls hover_command() const { return hover_; }
   const ControllerGains& gains() const { return gains_; }
@@ -134,6 +143,8 @@ class TrajectoryController {
 
  private:
   double collective_for_thrust(double thrust, const Vec3& air_body) const;
+  /// `accel` with the speed governor applied at `velocity`.
+  Vec3 govern_speed(const Vec3& accel, const Vec3& velocity) const;
   /// Angular acceleration the nominal model gives for controls (the
   /// inverse of the inner loop's inversion).
   Vec3 angular_accel_for(const vehicle::Controls& c, double thrust, const Vec3& air_body,
@@ -144,6 +155,8 @@ class TrajectoryController {
   std::unique_ptr<AdaptiveElement> adaptive_;
   vehicle::Controls hover_;
   Vec3 position_integral_ = Vec3::Zero();
+  double governed_speed_ = 0;           // m/s, 0: no governor
+  double governed_vertical_speed_ = 0;  // m/s, 0: no governor
   Vec3 attitude_integral_ = Vec3::Zero();
   double tail_thrust_estimate_ = 0;  // N, side force of the tail rotor
   double hover_tail_thrust_ = 0;     // N, its hover value, after a reset
