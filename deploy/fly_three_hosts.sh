@@ -451,8 +451,12 @@ for h in onboard1 onboard2; do
   [[ -z ${launcher_pid[$h]:-} ]] || onboard+=("${launcher_pid[$h]}")
 done
 stop_and_wait TERM 5 "${probe_pid[@]}"
+# After Ctrl-C or SIGTERM the launchers have had the signal already; a
+# second one would make them kill their services without the grace period.
+stop_signal=INT
+[[ -z $interrupted ]] || stop_signal=0
 # shellcheck disable=SC2068
-stop_and_wait INT 20 ${onboard[@]}
+stop_and_wait "$stop_signal" 20 ${onboard[@]}
 latency=$(summarise_latency)
 cleanup
 left=$(ip netns list | grep -c "^$tag-" || true)
