@@ -44,6 +44,7 @@ test: deps build
 	cd $(BUILD) && ctest --output-on-failure -j 2 --timeout 600
 
 bench: deps build
+	cmake --build $(BUILD) -j $(JOBS) --target ofn_benchmarks ofn_tracking_sweep
 	bench/run_benchmarks.sh $(BUILD)
 
 spy: deps build

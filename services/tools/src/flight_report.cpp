@@ -76,7 +76,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
                                  const std::optional<Scenario>& scenario,
                                  const PseudoControlBound& pseudo_control_bound) {
   lcm::LogFile log(log_path, "r");
-  if (!log.good()) throw std::runtime_error("cannot read LCM log " + log_path);
+  if (!log.good()) throw std::invalid_argument("cannot read LCM log " + log_path);
   namespace fs = std::filesystem;
   const fs::path out(out_dir);
   fs::create_directories(out);
@@ -251,7 +251,8 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     }
     if (!handle(e->channel, *e)) ++result.undecodable;
   }
-  if (nav.empty()) throw std::runtime_error(log_path + ": no NAV_STATE messages in the log");
+  // Bad input (exit code 2), like an unreadable log.
+  if (nav.empty()) throw std::invalid_argument(log_path + ": no NAV_STATE messages in the log");
 
   Limits limits;
   if (mission) {
