@@ -2,8 +2,8 @@
 # Random bytes, NaN-filled messages and well-formed forgeries (a clock jump,
 # a DONE, a plan at five times the speed limit, a cyclic beyond its range)
 # on every channel during a flight: nothing crashes, the rejection counters
-# rise, the run is not ended by the forged DONE, the vehicle never flies
-# faster than its limit, and the flight completes.
+# rise, the run is not ended by the forged DONE, the controller never flies
+# a reference faster than the limit, and the flight completes.
 source "$(dirname "$0")/common.sh"
 /usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/open.yaml" \
   --bin "$BIN" --rtf 4 --log-dir "$WORK/run" --timeout 150 --no-pin --max-restarts 0 \
@@ -20,10 +20,19 @@ log=$(cat "$WORK/run/latest_log")
   --out "$WORK/report" > "$WORK/report.txt" || [[ $? == 1 ]] || fail "report failed"
 grep -q "reached the last waypoint" "$WORK/report.txt" || fail "flight did not complete"
 grep -q "monitor: DONE not taken" "$WORK/launch.txt" || fail "the forged DONE went unnoticed"
-/usr/bin/python3 - "$WORK/report/summary.json" <<'PY' || fail "the vehicle left its speed limit"
-import json, sys
-s = json.load(open(sys.argv[1]))
-print("max speed %.3f m/s, limit %.3f m/s" % (s["max_speed"], s["limits"]["max_speed"]))
-sys.exit(0 if s["max_speed"] <= 1.02 * s["limits"]["max_speed"] else 1)
+# The forged plan at five times the speed limit was never flown: the
+# controller's reference (waypoint or trajectory mode; the forged statuses
+# in the log are DONE or NaN) stayed within the limit. (The flown speed
+# depends on the load of a machine running other tests beside this one.)
+/usr/bin/python3 - "$WORK/report" <<'PY' || fail "the controller flew a reference beyond the speed limit"
+import csv, json, math, sys
+limit = json.load(open(sys.argv[1] + "/summary.json"))["limits"]["max_speed"]
+fastest = 0.0
+for row in csv.DictReader(open(sys.argv[1] + "/control_status.csv")):
+    v = [float(row[k]) for k in ("ref_vn", "ref_ve", "ref_vd")]
+    if row["mode"] in ("1", "2") and all(math.isfinite(x) for x in v):
+        fastest = max(fastest, math.sqrt(sum(x * x for x in v)))
+print("fastest reference %.3f m/s, limit %.3f m/s" % (fastest, limit))
+sys.exit(0 if 0 < fastest <= 1.02 * limit else 1)
 PY
 pass "flood rejected and counted; flight completed"
