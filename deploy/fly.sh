@@ -5,6 +5,9 @@
 # `make run` is this script with the Makefile's SCENARIO and RTF.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
+program=fly.sh
+# shellcheck source=deploy/flight_common.sh
+source "$repo/deploy/flight_common.sh"
 scenario="$repo/sim/scenarios/bench3.yaml"
 rtf=1.0
 timeout=300
@@ -40,15 +43,6 @@ it, 128+N when stopped by signal N).
 EOF
 }
 
-die_usage() {  # one line, exit code 2
-  echo "fly.sh: error: $* (see --help)" >&2
-  exit 2
-}
-
-need_value() {  # need_value OPTION NUMBER_OF_ARGS_LEFT
-  [[ $2 -ge 2 ]] || die_usage "$1 needs a value"
-}
-
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --scenario) need_value "$1" $#; scenario=$2; shift 2 ;;
@@ -64,13 +58,7 @@ while [[ $# -gt 0 ]]; do
     *) die_usage "unknown option '$1'" ;;
   esac
 done
-positive='^([0-9]+\.?[0-9]*|\.[0-9]+)$'
-[[ $rtf =~ $positive ]] && awk -v x="$rtf" 'BEGIN { exit !(x > 0) }' ||
-  die_usage "--rtf must be a positive number, got '$rtf'"
-[[ $timeout =~ $positive ]] || die_usage "--timeout must be a number of seconds >= 0, got '$timeout'"
-[[ -n $scenario ]] || die_usage "--scenario is empty"
-[[ -f "$scenario" ]] || { echo "fly.sh: error: scenario file '$scenario' not found" >&2; exit 2; }
-[[ -x "$repo/build/bin/ofn_flight_report" ]] || { echo "fly.sh: error: not built yet: run 'make build'" >&2; exit 2; }
+check_flight_options "$scenario" "$rtf" "$timeout" "$repo/build/bin"
 [[ -n "$out" ]] || out="$repo/results/run-$(date +%Y%m%d-%H%M%S)"
 mkdir -p "$out"
 
@@ -83,35 +71,9 @@ if [[ $netns == 1 ]]; then
 else
   "${launch[@]}" || status=$?
 fi
-if [[ $status == 2 ]]; then
-  # The launcher rejected its input, or a service its configuration: there
-  # was no flight to report on (the launcher said why, above).
-  echo "fly: no flight: a configuration or usage error (see the launcher's message above)" >&2
-  exit 2
-fi
+exit_if_no_flight "$status"
 [[ -f "$out/latest_log" ]] || { echo "fly: no flight log was recorded" >&2; exit 1; }
 log=$(cat "$out/latest_log")
 echo
-# The report's exit code is the verdict (1: the flight failed); the figure is
-# drawn either way, since a failed flight is the one to look at.
-report_status=0
-"$repo/build/bin/ofn_flight_report" --log "$log" --scenario "$scenario" \
-  --controller-config "$repo/config/controller.yaml" --out "$out" || report_status=$?
-/usr/bin/python3 "$repo/services/tools/plot_flight.py" "$out" >/dev/null &&
-  echo "  figures           : $out/flight.png, $out/tracking.png"
-# replay.sh's 'latest' is the newest flight in results/ or a folder just below.
-out_abs=$(cd "$out" && pwd)
-replay=$log
-[[ $out_abs == "$repo/results" || $(dirname "$out_abs") == "$repo/results" ]] && replay=latest
-echo "  replay            : deploy/replay.sh $replay"
-if [[ $report_status == 1 ]]; then
-  echo "fly: the flight failed (see the outcome above)" >&2
-  exit 1
-elif [[ $report_status != 0 ]]; then
-  echo "fly: the flight report could not be written (exit code $report_status)" >&2
-  exit $report_status
-fi
-if [[ $status != 0 ]]; then
-  echo "fly: the flight did not complete (launcher exit code $status)" >&2
-fi
-exit $status
+report_flight "$repo/build/bin" "$out" "$scenario" "$log"
+finish_flight "$out" "$log" "$status"

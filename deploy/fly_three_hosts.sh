@@ -10,6 +10,9 @@
 # `make run HOSTS=3` is this script with the Makefile's SCENARIO and RTF.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
+program=fly_three_hosts.sh
+# shellcheck source=deploy/flight_common.sh
+source "$repo/deploy/flight_common.sh"
 scenario="$repo/sim/scenarios/bench3.yaml"
 rtf=1.0
 timeout=300
@@ -59,15 +62,6 @@ otherwise the ground station's launcher's (0 when the run ended normally,
 EOF
 }
 
-die_usage() {  # one line, exit code 2
-  echo "fly_three_hosts.sh: error: $* (see --help)" >&2
-  exit 2
-}
-
-need_value() {  # need_value OPTION NUMBER_OF_ARGS_LEFT
-  [[ $2 -ge 2 ]] || die_usage "$1 needs a value"
-}
-
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --scenario) need_value "$1" $#; scenario=$2; shift 2 ;;
@@ -87,16 +81,11 @@ while [[ $# -gt 0 ]]; do
     *) die_usage "unknown option '$1'" ;;
   esac
 done
-positive='^([0-9]+\.?[0-9]*|\.[0-9]+)$'
-[[ $rtf =~ $positive ]] && awk -v x="$rtf" 'BEGIN { exit !(x > 0) }' ||
-  die_usage "--rtf must be a positive number, got '$rtf'"
-[[ $timeout =~ $positive ]] || die_usage "--timeout must be a number of seconds >= 0, got '$timeout'"
-[[ $probe_rate =~ $positive ]] && awk -v x="$probe_rate" 'BEGIN { exit !(x > 0 && x <= 1000) }' ||
+bin=$(cd "$bin" 2>/dev/null && pwd) || bin=/nonexistent
+check_flight_options "$scenario" "$rtf" "$timeout" "$bin"
+[[ $probe_rate =~ ^([0-9]+\.?[0-9]*|\.[0-9]+)$ ]] &&
+  awk -v x="$probe_rate" 'BEGIN { exit !(x > 0 && x <= 1000) }' ||
   die_usage "--probe-rate must be a number in (0, 1000], got '$probe_rate'"
-[[ -n $scenario ]] || die_usage "--scenario is empty"
-[[ -f "$scenario" ]] || { echo "fly_three_hosts.sh: error: scenario file '$scenario' not found" >&2; exit 2; }
-bin=$(cd "$bin" 2>/dev/null && pwd) && [[ -x "$bin/ofn_flight_report" ]] ||
-  { echo "fly_three_hosts.sh: error: not built yet: run 'make build'" >&2; exit 2; }
 for tool in ip setsid setpriv; do
   command -v "$tool" >/dev/null ||
     { echo "fly_three_hosts.sh: error: '$tool' not found (apt-get install iproute2 util-linux)" >&2; exit 1; }
@@ -462,12 +451,7 @@ cleanup
 left=$(ip netns list | grep -c "^$tag-" || true)
 [[ $left == 0 ]] || warn "$left of the run's network namespaces are still there"
 
-if [[ $status == 2 || -n $config_error ]]; then
-  # The launcher rejected its input, or a service its configuration: there
-  # was no flight to report on (the launcher said why, above).
-  echo "fly: no flight: a configuration or usage error (see the launcher's message above)" >&2
-  exit 2
-fi
+exit_if_no_flight "$status" "$config_error"
 if [[ ! -f "$out/latest_log" ]]; then
   echo "$latency"
   echo "fly: no flight log was recorded" >&2
@@ -475,29 +459,8 @@ if [[ ! -f "$out/latest_log" ]]; then
 fi
 log=$(cat "$out/latest_log")
 echo
-# From here on what deploy/fly.sh does, with the same commands: the report's
-# exit code is the verdict (1: the flight failed); the figure is drawn either
-# way, since a failed flight is the one to look at.
-report_status=0
-"$bin/ofn_flight_report" --log "$log" --scenario "$scenario" \
-  --controller-config "$repo/config/controller.yaml" --out "$out" || report_status=$?
-/usr/bin/python3 "$repo/services/tools/plot_flight.py" "$out" >/dev/null &&
-  echo "  figures           : $out/flight.png, $out/tracking.png"
+report_flight "$bin" "$out" "$scenario" "$log"
 echo "$latency"
 [[ -f "$out/heartbeats.csv" ]] && { bridge_traffic || true; }
 echo "  hosts' logs       : $(dirname "$log")/$(basename "$log" .lcm)/ (gcs), $out/onboard1/, $out/onboard2/"
-# replay.sh's 'latest' is the newest flight in results/ or a folder just below.
-replay=$log
-[[ $out == "$repo/results" || $(dirname "$out") == "$repo/results" ]] && replay=latest
-echo "  replay            : deploy/replay.sh $replay"
-if [[ $report_status == 1 ]]; then
-  echo "fly: the flight failed (see the outcome above)" >&2
-  exit 1
-elif [[ $report_status != 0 ]]; then
-  echo "fly: the flight report could not be written (exit code $report_status)" >&2
-  exit $report_status
-fi
-if [[ $status != 0 ]]; then
-  echo "fly: the flight did not complete (launcher exit code $status)" >&2
-fi
-exit $status
+finish_flight "$out" "$log" "$status"

@@ -169,7 +169,7 @@ class FlyThenReplayTest(ScratchTestCase):
         self.repo = os.path.join(self.dir, "repo")
         for sub in ("deploy", "build/bin", "services/tools", "config", "sim/scenarios"):
             os.makedirs(os.path.join(self.repo, sub))
-        for name in ("fly.sh", "launch.py", "netns.sh", "replay.sh"):
+        for name in ("fly.sh", "flight_common.sh", "launch.py", "netns.sh", "replay.sh"):
             shutil.copy2(os.path.join(DEPLOY, name), os.path.join(self.repo, "deploy", name))
         with open(os.path.join(self.repo, "sim/scenarios/bench3.yaml"), "w") as f:
             f.write("name: stand-in\n")
