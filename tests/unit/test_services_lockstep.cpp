@@ -370,35 +370,37 @@ TEST_F(LockstepServices, AForgedPlanBeyondTheSpeedLimitIsNeverFlown) {
   }
 }
 
-TEST_F(LockstepServices, AMissionBeyondTheAirframeOrTheFenceIsRefused) {
+/// The controller's mode after 1 s of `mission` uplinked every 0.1 s over a
+/// hovering vehicle at `here`, and its rejections whose kind contains `text`.
+std::pair<int8_t, int64_t> fly_mission_only(const mission_t& mission, const Vec3& here,
+                                            const std::string& text) {
   sim::Lockstep lockstep;
-  const Scenario open = load_scenario(kOpenScenario);
-  const Vec3 here = open.waypoints.front().position;
   NavFeeder nav(lockstep, here);
-  mission_t fast = uplink::mission_from_scenario(open, 1);
-  fast.limits.max_speed = 30.0;  // the airframe's configured limit is 10 m/s
-  TrajectoryFeeder feeder(lockstep, fast, here);
+  TrajectoryFeeder feeder(lockstep, mission, here);
   feeder.from = 1e9;  // missions only
   control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
                                         default_controller_config());
   for (Node* n : {&nav.node(), &feeder.node(), &controller.node()}) lockstep.add(*n);
   lockstep.run(to_utime(1.0));
-  EXPECT_EQ(controller.mode(), control_status_t::HOLD);
-  EXPECT_GE(rejected_with(controller.node(), "mission refused: speed limit"), 5);
+  return {controller.mode(), rejected_with(controller.node(), text)};
+}
+
+TEST_F(LockstepServices, AMissionBeyondTheAirframeOrTheFenceIsRefused) {
+  const Scenario open = load_scenario(kOpenScenario);
+  const Vec3 here = open.waypoints.front().position;
+  mission_t fast = uplink::mission_from_scenario(open, 1);
+  fast.limits.max_speed = 30.0;  // the airframe's configured limit is 10 m/s
+  const auto [fast_mode, fast_refusals] =
+      fly_mission_only(fast, here, "mission refused: speed limit");
+  EXPECT_EQ(fast_mode, control_status_t::HOLD);
+  EXPECT_GE(fast_refusals, 5);
 
   // A waypoint 5 km away: outside the default geofence.
-  sim::Lockstep lockstep2;
-  NavFeeder nav2(lockstep2, here);
   mission_t far = uplink::mission_from_scenario(open, 1);
   far.waypoints.back().position[0] = 5000.0;
-  TrajectoryFeeder feeder2(lockstep2, far, here);
-  feeder2.from = 1e9;
-  control::ControllerService controller2(lockstep2.lcm(), lockstep2.clock(),
-                                         default_controller_config());
-  for (Node* n : {&nav2.node(), &feeder2.node(), &controller2.node()}) lockstep2.add(*n);
-  lockstep2.run(to_utime(1.0));
-  EXPECT_EQ(controller2.mode(), control_status_t::HOLD);
-  EXPECT_GE(rejected_with(controller2.node(), "outside the geofence"), 5);
+  const auto [far_mode, far_refusals] = fly_mission_only(far, here, "outside the geofence");
+  EXPECT_EQ(far_mode, control_status_t::HOLD);
+  EXPECT_GE(far_refusals, 5);
 }
 
 TEST_F(LockstepServices, VehicleSimRefusesActuatorCommandsBeyondTheAirframesRange) {
