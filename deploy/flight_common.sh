@@ -13,6 +13,23 @@ need_value() {  # need_value OPTION NUMBER_OF_ARGS_LEFT
   [[ $2 -ge 2 ]] || die_usage "$1 needs a value"
 }
 
+flight_option() {  # flight_option ARGS...: one of the options both scripts take
+  # (--scenario, --rtf, --out, --timeout, as "--x V" or "--x=V"); sets them
+  # and `taken`, the number of arguments used; anything else is a usage error.
+  case "$1" in
+    --scenario | --rtf | --out | --timeout) need_value "$1" $#; taken=2; local value=$2 ;;
+    --scenario=* | --rtf=* | --out=* | --timeout=*) taken=1; local value=${1#*=} ;;
+    *) die_usage "unknown option '$1'" ;;
+  esac
+  local name=${1%%=*}
+  case "$name" in
+    --scenario) scenario=$value ;;
+    --rtf) rtf=$value ;;
+    --out) out=$value ;;
+    --timeout) timeout=$value ;;
+  esac
+}
+
 check_flight_options() {  # check_flight_options SCENARIO RTF TIMEOUT BIN
   local positive='^([0-9]+\.?[0-9]*|\.[0-9]+)$'
   [[ $2 =~ $positive ]] && awk -v x="$2" 'BEGIN { exit !(x > 0) }' ||

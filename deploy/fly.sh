@@ -45,17 +45,9 @@ EOF
 
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --scenario) need_value "$1" $#; scenario=$2; shift 2 ;;
-    --scenario=*) scenario=${1#*=}; shift ;;
-    --rtf) need_value "$1" $#; rtf=$2; shift 2 ;;
-    --rtf=*) rtf=${1#*=}; shift ;;
-    --out) need_value "$1" $#; out=$2; shift 2 ;;
-    --out=*) out=${1#*=}; shift ;;
-    --timeout) need_value "$1" $#; timeout=$2; shift 2 ;;
-    --timeout=*) timeout=${1#*=}; shift ;;
     --host-network) netns=0; shift ;;
     -h|--help) usage; exit 0 ;;
-    *) die_usage "unknown option '$1'" ;;
+    *) flight_option "$@"; shift "$taken" ;;
   esac
 done
 check_flight_options "$scenario" "$rtf" "$timeout" "$repo/build/bin"

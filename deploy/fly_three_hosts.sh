@@ -64,21 +64,13 @@ EOF
 
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --scenario) need_value "$1" $#; scenario=$2; shift 2 ;;
-    --scenario=*) scenario=${1#*=}; shift ;;
-    --rtf) need_value "$1" $#; rtf=$2; shift 2 ;;
-    --rtf=*) rtf=${1#*=}; shift ;;
-    --out) need_value "$1" $#; out=$2; shift 2 ;;
-    --out=*) out=${1#*=}; shift ;;
-    --timeout) need_value "$1" $#; timeout=$2; shift 2 ;;
-    --timeout=*) timeout=${1#*=}; shift ;;
     --bin) need_value "$1" $#; bin=$2; shift 2 ;;
     --bin=*) bin=${1#*=}; shift ;;
     --no-pin) no_pin=(--no-pin); shift ;;
     --probe-rate) need_value "$1" $#; probe_rate=$2; shift 2 ;;
     --probe-rate=*) probe_rate=${1#*=}; shift ;;
     -h|--help) usage; exit 0 ;;
-    *) die_usage "unknown option '$1'" ;;
+    *) flight_option "$@"; shift "$taken" ;;
   esac
 done
 bin=$(cd "$bin" 2>/dev/null && pwd) || bin=/nonexistent
