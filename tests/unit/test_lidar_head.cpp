@@ -87,6 +87,7 @@ TEST(LidarHead, MaxRangeComesFromConfigThenScenarioThenDefault) {
 TEST(LidarHead, LevelVehicleFacingAWallMeasuresItsDistance) {
   LidarHead head(exact_config(), 0.0);
   const LidarScan scan = head.scan(0, level_at(kAt10m), wall_world(20.0));
+  ASSERT_EQ(static_cast<int>(scan.beams.size()), head.beams_per_scan());
   for (const auto& b : scan.beams) {
     ASSERT_EQ(b.status, kLidarOk);
     EXPECT_EQ(b.truth_id, kWallId);
@@ -108,6 +109,7 @@ TEST(LidarHead, MountOffsetAndAttitudeMoveTheBeams) {
   c.mount_rpy = Vec3(0, 0, deg2rad(90));
   LidarHead sideways(c, 0.0);
   const LidarScan scan = sideways.scan(0, level_at(kAt10m), wall_world(20.0));
+  ASSERT_EQ(static_cast<int>(scan.beams.size()), sideways.beams_per_scan());
   for (const auto& b : scan.beams) EXPECT_EQ(b.status, kLidarMaxRange);
 }
 
@@ -137,8 +139,9 @@ TEST(LidarHead, DropoutProbabilityOneLosesEveryReturn) {
   LidarConfig c = exact_config();
   c.dropout_probability = 1.0;
   LidarHead head(c, 0.0);
-  for (const auto& b : head.scan(0, level_at(kAt10m), wall_world()).beams)
-    EXPECT_EQ(b.status, kLidarNoReturn);
+  const LidarScan scan = head.scan(0, level_at(kAt10m), wall_world());
+  ASSERT_EQ(static_cast<int>(scan.beams.size()), head.beams_per_scan());
+  for (const auto& b : scan.beams) EXPECT_EQ(b.status, kLidarNoReturn);
 }
 
 TEST(LidarHead, SomeReturnsDropOutAtTheDefaultProbability) {
@@ -155,7 +158,9 @@ TEST(LidarHead, SomeReturnsDropOutAtTheDefaultProbability) {
 TEST(LidarHead, NearFieldReturnsAreSaturated) {
   LidarHead head(exact_config(), 0.0);
   // 0.7 m from the wall: every beam's return is inside the 1 m saturation range.
-  for (const auto& b : head.scan(0, level_at(kAt10m), wall_world(0.7)).beams) {
+  const LidarScan scan = head.scan(0, level_at(kAt10m), wall_world(0.7));
+  ASSERT_EQ(static_cast<int>(scan.beams.size()), head.beams_per_scan());
+  for (const auto& b : scan.beams) {
     EXPECT_EQ(b.status, kLidarSaturated);
     EXPECT_EQ(b.truth_id, kWallId);
   }
@@ -257,6 +262,7 @@ TEST(LidarHead, SameSeedGivesIdenticalScansAndAnotherSeedDiffers) {
     const LidarScan sb = b.scan(k * 80'000, level_at(kAt10m), w);
     const LidarScan so = other.scan(k * 80'000, level_at(kAt10m), w);
     EXPECT_EQ(sa.scan_index, k);
+    ASSERT_EQ(static_cast<int>(sa.beams.size()), a.beams_per_scan());
     int same_as_other = 0;
     for (size_t i = 0; i < sa.beams.size(); ++i) {
       EXPECT_EQ(sa.beams[i].range, sb.beams[i].range);

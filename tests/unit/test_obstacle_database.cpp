@@ -168,6 +168,7 @@ TEST(ObstacleDatabase, StaircasePiecesStaySeparateEntriesWithStableIds) {
   EXPECT_EQ(db.inserted(), static_cast<int>(staircase.size()));
   EXPECT_EQ(db.merged(), 0);
   EXPECT_EQ(db.retired(), 0);
+  ASSERT_EQ(db.entries().size(), staircase.size());
   for (const auto& e : db.entries()) EXPECT_DOUBLE_EQ(e.confidence, 1.0);
 }
 

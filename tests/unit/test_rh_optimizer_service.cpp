@@ -196,6 +196,7 @@ TEST_F(RhOptimizerServiceTest, BadInputIsRejectedCountedAndSurvived) {
   // Still working.
   for (int i = 0; i < 3; ++i) step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
   EXPECT_TRUE(service_.engaged());
+  ASSERT_FALSE(trajs_.empty());
   for (const auto& t : trajs_)
     for (const auto& p : t.position)
       for (double v : p) EXPECT_TRUE(std::isfinite(v));

@@ -134,6 +134,7 @@ TEST(ScenarioObstacles, TreeCourseFliesLowWithALargeClearance) {
   EXPECT_NEAR(o.width, 60 * kFt, 1e-9);
   EXPECT_NEAR(o.height, 50 * kFt, 1e-9);
   EXPECT_NEAR(s.start_position.z(), -60 * kFt, 1e-9);
+  ASSERT_EQ(s.waypoints.size(), 2u);
   for (const auto& w : s.waypoints) EXPECT_NEAR(w.position.z(), -60 * kFt, 1e-9);
   EXPECT_NEAR(s.limits.clearance, 50 * kFt, 1e-9);
   EXPECT_NEAR(s.limits.max_accel, 1.65 * kFt, 1e-9);
