@@ -100,6 +100,11 @@ def machine_info():
     return {"cores": os.cpu_count(), "cpu": model}
 
 
+def default_jobs():
+    """--jobs default: one flight per core."""
+    return max(1, os.cpu_count() or 1)
+
+
 def git_commit():
     try:
         out = subprocess.run(["git", "-C", REPO, "rev-parse", "--short", "HEAD"], capture_output=True,
@@ -488,8 +493,9 @@ def build_parser():
     ap.add_argument("--courses", metavar="NAME[,NAME]",
                     help="comma-separated courses of sim/scenarios/ (default: %s; with --quick %s)"
                          % (",".join(COURSES), ",".join(QUICK_COURSES)))
-    ap.add_argument("--jobs", type=int, default=2, metavar="N",
-                    help="lockstep flights at a time (default: 2)")
+    ap.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
+                    help="lockstep flights at a time (default: the number of cores, %d here)"
+                         % default_jobs())
     ap.add_argument("--multiprocess", default=None, metavar="COURSE|none",
                     help="course flown through the multi-process deployment "
                          "(default: bench3; with --quick none)")

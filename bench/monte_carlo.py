@@ -419,7 +419,9 @@ def build_parser():
     ap.add_argument("--seeds", metavar="S[,S]",
                     help="comma-separated seeds to fly, e.g. 64,131,257 "
                          "(default: --seed-base and --runs)")
-    ap.add_argument("--jobs", type=int, default=2, metavar="N", help="flights at a time (default: 2)")
+    ap.add_argument("--jobs", type=int, default=campaign.default_jobs(), metavar="N",
+                    help="flights at a time (default: the number of cores, %d here)"
+                         % campaign.default_jobs())
     ap.add_argument("--out", default=os.path.join(REPO, "results", "monte_carlo"), metavar="DIR",
                     help="results folder (default: results/monte_carlo)")
     ap.add_argument("--config-dir", default=campaign.DEFAULT_CONFIG, metavar="DIR",
