@@ -96,28 +96,81 @@ TEST(PathHeading, FacesWhereThePlanIsGoingNotOnlyWhereItGoesNow) {
   EXPECT_FALSE(facing_ahead(here, Vec3(0.5, 0, 0), ahead, 1.0));
 }
 
-TEST(YawSweepOffset, StartsAtRestAndReachesTheFullSweepAfterOnePeriod) {
+/// Flies the sweep generator for `seconds` toward `half` (rad) and returns
+/// the largest |offset| and |rate| over the last `window` seconds, checking
+/// on the way that the rate is the offset's derivative.
+struct SweepPeaks {
+  double offset = 0;
+  double rate = 0;
+};
+SweepPeaks fly_sweep(YawSweepGenerator& generator, double half, double seconds, double window) {
+  SweepPeaks peaks;
+  double previous = 0, previous_rate = 0;
+  const int steps = static_cast<int>(std::lround(seconds / kDt));
+  for (int k = 0; k < steps; ++k) {
+    double rate = 0;
+    const double offset = generator.update(half, kDt, &rate);
+    // Trapezoidal integration of the rate follows the offset.
+    if (k > 0) {
+      EXPECT_NEAR(offset - previous, 0.5 * (rate + previous_rate) * kDt, 2e-5) << k;
+    }
+    previous = offset;
+    previous_rate = rate;
+    if ((k + 1) * kDt > seconds - window) {
+      peaks.offset = std::max(peaks.offset, std::abs(offset));
+      peaks.rate = std::max(peaks.rate, std::abs(rate));
+    }
+  }
+  return peaks;
+}
+
+TEST(YawSweepGenerator, StartsAtRestAndReachesTheFullSweepAfterOnePeriod) {
   YawSweep sweep;
   sweep.frequency = 0.2;
   sweep.total_angle = deg2rad(40);
+  YawSweepGenerator generator(sweep);
   double rate = 1.0;
-  EXPECT_DOUBLE_EQ(yaw_sweep_offset(sweep, 0.0, &rate), 0.0);
-  EXPECT_DOUBLE_EQ(rate, 0.0);
-  // After the ramp, the peaks are at +-half the total angle.
-  double largest = 0;
-  for (double t = 5.0; t < 15.0; t += kDt)
-    largest = std::max(largest, std::abs(yaw_sweep_offset(sweep, t, &rate)));
-  EXPECT_NEAR(largest, deg2rad(20), 1e-4);
-  // The rate is the derivative of the offset.
-  for (double t : {0.7, 3.1, 6.2, 9.9}) {
-    const double h = 1e-6;
-    double unused = 0;
-    const double numeric =
-        (yaw_sweep_offset(sweep, t + h, &unused) - yaw_sweep_offset(sweep, t - h, &unused)) /
-        (2 * h);
-    yaw_sweep_offset(sweep, t, &rate);
-    EXPECT_NEAR(rate, numeric, 1e-6) << "t = " << t;
-  }
+  // The first step commands no offset and no rate.
+  EXPECT_EQ(generator.update(deg2rad(20), kDt, &rate), 0.0);
+  EXPECT_EQ(rate, 0.0);
+  generator.restart();
+  // After the ramp (one period), the peaks are at +-half the total angle,
+  // at the nominal peak rate 2 pi f a.
+  const SweepPeaks peaks = fly_sweep(generator, deg2rad(20), 15.0, 10.0);
+  EXPECT_NEAR(peaks.offset, deg2rad(20), 1e-4);
+  EXPECT_NEAR(peaks.rate, 2 * kPi * 0.2 * deg2rad(20), 1e-4);
+  EXPECT_NEAR(generator.half_angle(), deg2rad(20), 1e-12);
+}
+
+TEST(YawSweepGenerator, WidensWhenAskedWithoutExceedingTheNominalPeakRate) {
+  YawSweep sweep;  // +-20 deg at 0.2 Hz, up to +-60 deg
+  YawSweepGenerator generator(sweep);
+  fly_sweep(generator, deg2rad(20), 10.0, 0.0);
+  const double nominal_rate = 2 * kPi * sweep.frequency * deg2rad(20);
+  // Asked for +-60 deg: it widens at widen_rate, the peak rate stays.
+  const SweepPeaks wide = fly_sweep(generator, deg2rad(60), 40.0, 15.0);
+  EXPECT_NEAR(generator.half_angle(), deg2rad(60), 1e-6);
+  EXPECT_NEAR(wide.offset, deg2rad(60), 2e-3);
+  EXPECT_LE(wide.rate, nominal_rate * 1.001 + sweep.widen_rate);
+  EXPECT_NEAR(wide.rate, nominal_rate, 1e-3);
+  // Never wider than the wide limit, and back to nominal when asked.
+  fly_sweep(generator, deg2rad(170), 20.0, 0.0);
+  EXPECT_NEAR(generator.half_angle(), deg2rad(60), 1e-6);
+  const SweepPeaks back = fly_sweep(generator, 0.0, 20.0, 10.0);
+  EXPECT_NEAR(generator.half_angle(), deg2rad(20), 1e-6);
+  EXPECT_NEAR(back.offset, deg2rad(20), 2e-3);
+}
+
+TEST(SweepHalfAngle, NominalWhileFacingWhereItGoesWideWhenSlower) {
+  YawSweep sweep;  // +-20 deg, up to +-60 deg
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 3.048, 1.0), deg2rad(20));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 1.0, 1.0), deg2rad(20));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.99, 1.0), deg2rad(60));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.0, 1.0), deg2rad(60));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, std::nan(""), 1.0), deg2rad(20));
+  // Widening off: total_angle only.
+  sweep.wide_total_angle = sweep.total_angle;
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.0, 1.0), deg2rad(20));
 }
 
 }  // namespace

@@ -260,6 +260,7 @@ class TrajectoryFeeder {
   Node& node() { return node_; }
   Vec3 velocity = Vec3::Zero();
   double from = 0;
+  int8_t mode = ref_traj_t::AVOIDANCE;
 
  private:
   void publish() {
@@ -269,7 +270,7 @@ class TrajectoryFeeder {
     m.utime = node_.now();
     m.t0_utime = m.utime;
     m.frame = "NED";
-    m.mode = ref_traj_t::AVOIDANCE;
+    m.mode = mode;
     m.num_samples = 2;
     m.sample_time = {0.0, 1.0};
     const Vec3 ahead = position_ + velocity;
@@ -334,6 +335,52 @@ TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
   }
   // Slow: the heading stays east.
   EXPECT_NEAR(yaw_at(8.9), 90.0, 1e-6);
+}
+
+TEST_F(LockstepServices, ALookAroundTurnsSteadilyAndAdaptationLearnsOnlyInFlight) {
+  // From 1 s the optimiser asks for a look-around: a hover during which the
+  // heading turns at its rate limit, fed forward, with the adaptive
+  // element's weights held (as at any hover); a plan flown at speed after it
+  // releases them.
+  sim::Lockstep lockstep;
+  const Scenario open = load_scenario(kOpenScenario);
+  const Vec3 here = open.waypoints.front().position;
+  NavFeeder nav(lockstep, here);
+  TrajectoryFeeder feeder(lockstep, uplink::mission_from_scenario(open, 1), here);
+  feeder.from = 1.0;
+  feeder.mode = ref_traj_t::LOOK_AROUND;
+  auto config = default_controller_config();
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(), config);
+  BusRecorder recorder(lockstep);
+  for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})
+    lockstep.add(*n);
+  lockstep.run(to_utime(4.0));
+  EXPECT_EQ(controller.mode(), control_status_t::TRAJECTORY);
+  EXPECT_TRUE(controller.adaptation_held());
+  // Turning at the limit: 30 deg/s between status messages, once turning.
+  ASSERT_GE(recorder.status.size(), 100u);
+  double largest_step = 0, turned = 0;
+  for (size_t i = 1; i < recorder.status.size(); ++i) {
+    if (to_seconds(recorder.status[i - 1].utime) < 1.5) continue;
+    const double dt = to_seconds(recorder.status[i].utime - recorder.status[i - 1].utime);
+    const double step = wrap_angle(recorder.status[i].yaw_reference -
+                                   recorder.status[i - 1].yaw_reference);
+    EXPECT_NEAR(step, config.heading.max_rate * dt, 1e-9) << "at " << i;
+    largest_step = std::max(largest_step, std::abs(step));
+    turned += step;
+  }
+  EXPECT_NEAR(rad2deg(turned), 30.0 * 2.5, 1.0);
+  // A plan at cruise speed: learning resumes.
+  feeder.mode = ref_traj_t::AVOIDANCE;
+  feeder.velocity = nav.velocity = Vec3(3, 0, 0);
+  lockstep.run(to_utime(4.5));
+  EXPECT_EQ(controller.mode(), control_status_t::TRAJECTORY);
+  EXPECT_FALSE(controller.adaptation_held());
+  // Creeping, slower than the path heading's min_speed: held again.
+  feeder.velocity = nav.velocity = Vec3(0.5, 0, 0);
+  lockstep.run(to_utime(5.0));
+  EXPECT_EQ(controller.mode(), control_status_t::TRAJECTORY);
+  EXPECT_TRUE(controller.adaptation_held());
 }
 
 /// The rejections of `node` whose kind contains `text`.

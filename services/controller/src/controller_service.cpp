@@ -130,6 +130,10 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.sweep.total_angle =
       deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
   c.sweep.scanner_timeout = sweep.number_in("scanner_timeout", c.sweep.scanner_timeout, 0.05, 60.0);
+  c.sweep.wide_total_angle = deg2rad(
+      sweep.number_in("wide_total_deg", rad2deg(c.sweep.wide_total_angle), 0.0, 180.0));
+  c.sweep.widen_rate =
+      deg2rad(sweep.number_in("widen_rate_deg_s", rad2deg(c.sweep.widen_rate), 0.1, 180.0));
   sweep.finish();
   YamlReader heading = r.child("path_heading");
   c.heading.max_rate =
@@ -168,7 +172,8 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
       guidance_(config_.guidance),
       selector_(config_.selector),
       gate_(config_.gate),
-      path_heading_(config_.heading) {
+      path_heading_(config_.heading),
+      sweep_(config_.sweep) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
       SubscribeOptions{config_.nav_timeout, 0.5});
@@ -265,23 +270,32 @@ void ControllerService::on_lidar_scan() {
   last_scan_ = node_.now();
 }
 
-double ControllerService::yaw_reference(const std::optional<Vec3>& facing, double dt,
-                                        double* yaw_rate) {
+double ControllerService::yaw_reference(const std::optional<Vec3>& facing, bool looking_around,
+                                        double dt, double* yaw_rate) {
   // Face along the path; sweep the scanner while it runs.
-  *yaw_rate = 0;
   double yaw = path_heading_.update(facing, dt);
+  // A look-around turns steadily at the heading's limit: fed forward, the
+  // turn leaves no lag. Elsewhere the facing direction moves with every new
+  // plan and its rate is not fed forward.
+  *yaw_rate = looking_around ? path_heading_.turn_rate() : 0.0;
   const Utime now = node_.now();
   const bool scanner_on =
       last_scan_ != INT64_MIN && now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
   if (!(config_.sweep.enabled && scanner_on && mode_ != control_status_t::HOLD)) {
-    if (sweep_since_ != INT64_MIN) node_.log().info("yaw sweep stopped");
-    sweep_since_ = INT64_MIN;
+    if (sweeping_) node_.log().info("yaw sweep stopped");
+    sweeping_ = false;
   } else {
-    if (sweep_since_ == INT64_MIN) {
-      sweep_since_ = now;
+    if (!sweeping_) {
+      sweeping_ = true;
+      sweep_.restart();
       node_.log().info("scanner active: yaw sweep started");
     }
-    yaw += yaw_sweep_offset(config_.sweep, to_seconds(now - sweep_since_), yaw_rate);
+    // Wider while the vehicle is too slow to face where it goes.
+    const double speed = nav_ ? std::hypot(nav_->velocity[0], nav_->velocity[1]) : 0.0;
+    const double half = sweep_half_angle(config_.sweep, speed, config_.heading.min_speed);
+    double sweep_rate = 0;
+    yaw += sweep_.update(half, dt, &sweep_rate);
+    *yaw_rate += sweep_rate;
   }
   return wrap_angle(yaw);
 }
@@ -381,7 +395,13 @@ void ControllerService::control_step() {
   if (mode_ != previous)
     node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
                      static_cast<int>(mode_), to_seconds(now));
-  ref.yaw = yaw_reference(facing, dt, &ref.yaw_rate);
+  const bool looking_around = mode_ == control_status_t::TRAJECTORY && ref_traj_ &&
+                              ref_traj_->mode == ref_traj_t::LOOK_AROUND;
+  // The networks learn in flight; at a hover and in a look-around the
+  // heading turning over a vehicle that barely moves is all they would see.
+  controller_.hold_adaptation(looking_around ||
+                              std::hypot(x.velocity.x(), x.velocity.y()) < config_.heading.min_speed);
+  ref.yaw = yaw_reference(facing, looking_around, dt, &ref.yaw_rate);
   // Whatever chose it, the reference flown stays inside the envelope.
   bool clamped = false;
   ref = gate_.clamp(ref, flight_limits(), &clamped);

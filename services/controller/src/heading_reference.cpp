@@ -11,10 +11,12 @@ void PathHeadingFilter::reset(double yaw) {
 }
 
 double PathHeadingFilter::update(const std::optional<Vec3>& facing, double dt) {
+  turn_rate_ = 0;
   if (facing) {
     const double step = wrap_angle(std::atan2(facing->y(), facing->x()) - yaw_);
     const double limit = settings_.max_rate * dt;
     yaw_ = wrap_angle(yaw_ + std::clamp(step, -limit, limit));
+    if (std::abs(step) >= limit && dt > 0) turn_rate_ = std::copysign(settings_.max_rate, step);
   }
   return yaw_;
 }
@@ -40,14 +42,53 @@ Vec3 look_around_facing(double yaw) {
   return Vec3(std::cos(ahead), std::sin(ahead), 0.0);
 }
 
-double yaw_sweep_offset(const YawSweep& sweep, double t, double* rate) {
-  const double w = 2.0 * kPi * sweep.frequency;
-  const double ramp = 1.0 / sweep.frequency;
-  const double half = 0.5 * sweep.total_angle;
-  const double a = half * std::min(1.0, t / ramp);
-  const double a_rate = t < ramp ? half / ramp : 0.0;
-  *rate = a_rate * std::sin(w * t) + a * w * std::cos(w * t);
-  return a * std::sin(w * t);
+double sweep_half_angle(const YawSweep& sweep, double speed, double slow_speed) {
+  const double nominal = 0.5 * sweep.total_angle;
+  const double wide = std::max(nominal, 0.5 * sweep.wide_total_angle);
+  return std::isfinite(speed) && speed < slow_speed ? wide : nominal;
+}
+
+void YawSweepGenerator::restart() {
+  half_ = 0;
+  half_rate_ = 0;
+  phase_ = 0;
+  faded_in_ = false;
+}
+
+double YawSweepGenerator::update(double target_half_angle, double dt, double* rate) {
+  const double nominal = 0.5 * sweep_.total_angle;
+  const double wide = std::max(nominal, 0.5 * sweep_.wide_total_angle);
+  const double target = std::clamp(target_half_angle, nominal, wide);
+  // How the half angle moves over the coming step.
+  bool fade_ends = false;
+  if (!faded_in_) {
+    // A linear fade over one period: it ends at a whole turn of the phase,
+    // where sin = 0, so the rate does not step when the fade stops.
+    half_rate_ = nominal * sweep_.frequency;
+    if (half_ + half_rate_ * dt >= nominal) {
+      half_rate_ = dt > 0 ? (nominal - half_) / dt : 0.0;
+      faded_in_ = fade_ends = true;
+    }
+  } else {
+    // Toward the target within kWidenSettle, at most widen_rate, the rate
+    // itself changing at most widen_rate per kWidenSettle: the yaw rate
+    // never steps.
+    const double desired =
+        std::clamp((target - half_) / kWidenSettle, -sweep_.widen_rate, sweep_.widen_rate);
+    const double change = sweep_.widen_rate * dt / kWidenSettle;
+    half_rate_ += std::clamp(desired - half_rate_, -change, change);
+    if (half_ + half_rate_ * dt < nominal || half_ + half_rate_ * dt > wide)
+      half_rate_ = dt > 0 ? (std::clamp(half_ + half_rate_ * dt, nominal, wide) - half_) / dt : 0.0;
+  }
+  // This step's offset and rate, from the state reached so far (the first
+  // step of a sweep commands zero), then the state moves on.
+  const double w = 2.0 * kPi * sweep_.frequency * (half_ > nominal ? nominal / half_ : 1.0);
+  const double offset = half_ * std::sin(phase_);
+  *rate = half_rate_ * std::sin(phase_) + half_ * w * std::cos(phase_);
+  half_ += half_rate_ * dt;
+  phase_ = std::fmod(phase_ + w * dt, 2.0 * kPi);
+  if (fade_ends) half_rate_ = 0;
+  return offset;
 }
 
 }  // namespace ofn::control

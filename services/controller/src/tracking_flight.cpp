@@ -46,6 +46,7 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
   TrackingResult r;
   PathHeadingFilter path_heading(setup.heading);
   path_heading.reset(scenario.start_heading);
+  YawSweepGenerator sweep(setup.sweep);
   double sum_sq = 0, sum_sq_first = 0, sum_sq_second = 0;
   int n = 0, n_first = 0, n_second = 0;
   const double half_time = 0.5 * (config.duration + config.settle_time);
@@ -67,7 +68,9 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
     // As the service: face the leg (not a vertical one), sweep on top.
     ref.yaw = path_heading.update(facing_along(g.leg_direction, kMinLegHorizontal), dt);
     if (config.yaw_sweep && setup.sweep.enabled) {
-      ref.yaw = wrap_angle(ref.yaw + yaw_sweep_offset(setup.sweep, t, &ref.yaw_rate));
+      const double half = sweep_half_angle(
+          setup.sweep, std::hypot(nav.velocity.x(), nav.velocity.y()), setup.heading.min_speed);
+      ref.yaw = wrap_angle(ref.yaw + sweep.update(half, dt, &ref.yaw_rate));
     }
 
     VehicleEstimate x;

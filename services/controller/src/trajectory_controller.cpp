@@ -288,7 +288,7 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
     out.hedge_angular = angular - angular_achievable;
   }
 
-  adaptive_->update(ad);
+  if (!adaptation_held_) adaptive_->update(ad);
 
   // Reference models advance by what the vehicle can follow.
   const Vec3 rm_accel_hedged = rm_accel - out.hedge_accel;

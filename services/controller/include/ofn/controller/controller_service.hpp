@@ -47,7 +47,8 @@ class ControllerService {
   ControllerService(lcm::LCM& lcm, const Clock& clock, ControllerConfig config);
   Node& node() { return node_; }
   int8_t mode() const { return mode_; }
-  bool sweeping() const { return sweep_since_ != INT64_MIN; }
+  bool sweeping() const { return sweeping_; }
+  bool adaptation_held() const { return controller_.adaptation_held(); }
 
  private:
   void on_nav(const nav_state_t& m) { nav_ = m; }
@@ -61,7 +62,8 @@ class ControllerService {
   Limits flight_limits() const;
   void control_step();
   void publish_status();
-  double yaw_reference(const std::optional<Vec3>& facing, double dt, double* yaw_rate);
+  double yaw_reference(const std::optional<Vec3>& facing, bool looking_around, double dt,
+                       double* yaw_rate);
 
   Node node_;
   ControllerConfig config_;
@@ -80,7 +82,8 @@ class ControllerService {
   ControlOutput last_out_;
   Utime last_step_ = INT64_MIN;
   Utime last_scan_ = INT64_MIN;
-  Utime sweep_since_ = INT64_MIN;  // start of the current sweep; INT64_MIN while off
+  YawSweepGenerator sweep_;
+  bool sweeping_ = false;
 };
 
 }  // namespace ofn::control

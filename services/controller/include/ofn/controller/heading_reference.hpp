@@ -13,11 +13,54 @@ namespace ofn::control {
 /// Oscillatory yaw that sweeps the vertical scanner across the path (paper
 /// section 3.1). It runs only while LIDAR scans arrive, and fades in over one
 /// period so that the yaw rate never steps.
+///
+/// The paper's sweep (+-20 deg) suits a vehicle that faces where it flies.
+/// Slower than the path heading's min_speed it does not: the heading holds
+/// while the vehicle creeps, stops and sets off sideways, and the space
+/// beside it that a stop or a turn could enter lies outside +-20 deg (dense
+/// fields: a cylinder 60 deg off the path of a vehicle creeping at 1 m/s,
+/// mapped only once it was 3.8 m away). So a slow vehicle sweeps wider
+/// (wide_total_angle), the frequency dropping so that the peak yaw rate stays
+/// the nominal one.
 struct YawSweep {
   bool enabled = true;
   double frequency = 0.2;            // Hz
-  double total_angle = deg2rad(40);  // rad, peak to peak
+  double total_angle = deg2rad(40);  // rad, peak to peak, at cruise
   double scanner_timeout = 1.0;      // s without LIDAR_RAW after which the scanner counts as off
+  /// rad, peak to peak, at the widest (hovering); total_angle: never widens.
+  double wide_total_angle = deg2rad(120);
+  double widen_rate = deg2rad(10);  // rad/s the half angle changes at most once faded in
+};
+
+/// Half angle (rad) of the sweep for a vehicle at horizontal `speed`: the
+/// wide one below `slow_speed` (the path heading's min_speed), else the
+/// nominal one.
+double sweep_half_angle(const YawSweep& sweep, double speed, double slow_speed);
+
+/// The sweep's yaw offset over time: a(t) sin(phi(t)). The half angle a
+/// ramps from zero to the nominal one over one period (the commanded yaw and
+/// its rate start at zero), then follows the target half angle at up to
+/// widen_rate, smoothly (its own rate changes gradually);
+/// the phase advances at 2 pi frequency, slowed where a exceeds the nominal
+/// half angle so that the peak yaw rate a phi' stays the nominal sweep's.
+class YawSweepGenerator {
+ public:
+  explicit YawSweepGenerator(YawSweep sweep = {}) : sweep_(sweep) {}
+  /// Back to zero amplitude and phase (the scanner started, or restarted).
+  void restart();
+  /// One step of `dt` s toward `target_half_angle` (rad); returns the yaw
+  /// offset and writes its rate to `rate`.
+  double update(double target_half_angle, double dt, double* rate);
+  double half_angle() const { return half_; }
+
+ private:
+  /// s within which the half angle heads for a new target.
+  static constexpr double kWidenSettle = 1.0;
+  YawSweep sweep_;
+  double half_ = 0;       // rad
+  double half_rate_ = 0;  // rad/s
+  double phase_ = 0;      // rad
+  bool faded_in_ = false;
 };
 
 /// How the vehicle faces along its path. A trajectory's velocity turns fast
@@ -36,9 +79,9 @@ struct PathHeading {
 };
 
 /// The path heading, turned toward the direction to face by at most
-/// max_rate * dt per step. It gives no yaw-rate feed-forward: the direction
-/// of a sampled reference jumps a little with every new trajectory, and its
-/// difference quotient would be noise.
+/// max_rate * dt per step. Short of its limit it gives no yaw-rate
+/// feed-forward: the direction of a sampled reference jumps a little with
+/// every new trajectory, and its difference quotient would be noise.
 class PathHeadingFilter {
  public:
   explicit PathHeadingFilter(PathHeading settings = {}) : settings_(settings) {}
@@ -52,10 +95,16 @@ class PathHeadingFilter {
   /// path heading in (-pi, pi].
   double update(const std::optional<Vec3>& facing, double dt);
   double yaw() const { return yaw_; }
+  /// rad/s: the rate of the last step while the heading turns at its limit
+  /// (a steady turn, as in a look-around), else 0. Fed forward, it removes
+  /// the lag a steady turn otherwise leaves (7 deg at 30 deg/s), which the
+  /// inner loop's adaptive element would keep learning from.
+  double turn_rate() const { return turn_rate_; }
 
  private:
   PathHeading settings_;
   double yaw_ = 0;
+  double turn_rate_ = 0;
   bool initialised_ = false;
 };
 
@@ -79,10 +128,5 @@ std::optional<Vec3> facing_ahead(const Vec3& here, const Vec3& velocity,
 /// `yaw`, so that the path heading, always turning toward it, turns at its
 /// full rate for as long as the look lasts.
 Vec3 look_around_facing(double yaw);
-
-/// The sweep's yaw offset `t` seconds after it started: a(t) sin(w t) with
-/// the amplitude a ramping linearly from zero over one period, so that the
-/// commanded yaw and its rate start at zero. `rate` receives its derivative.
-double yaw_sweep_offset(const YawSweep& sweep, double t, double* rate);
 
 }  // namespace ofn::control

@@ -135,6 +135,16 @@ class TrajectoryController {
   /// velocity loop saturated at the limit; far below it does nothing.
   /// Zero turns a limit off (the default).
   void set_speed_limits(double max_speed, double max_vertical_speed);
+  /// Holds the adaptive element's weights (it still adds what it has
+  /// learnt) while `hold` is true: for flight its inputs were never meant to
+  /// cover. The service holds them at a hover and in a look-around, where
+  /// the heading (one of the networks' inputs) turns through full turns and
+  /// sweeps +-60 deg while the vehicle barely moves: learning there, the
+  /// inner network drove roll limit cycles of 0.4-0.5 rad after dead-end
+  /// recoveries (dense fields 15, 18 and 20; without adaptation all three
+  /// flew cleanly).
+  void hold_adaptation(bool hold) { adaptation_held_ = hold; }
+  bool adaptation_held() const { return adaptation_held_; }
   /// Level-attitude hover command, the safe output when inputs are bad.
   vehicle::Controls hover_command() const { return hover_; }
   const ControllerGains& gains() const { return gains_; }
@@ -157,6 +167,7 @@ class TrajectoryController {
   Vec3 position_integral_ = Vec3::Zero();
   double governed_speed_ = 0;           // m/s, 0: no governor
   double governed_vertical_speed_ = 0;  // m/s, 0: no governor
+  bool adaptation_held_ = false;
   Vec3 attitude_integral_ = Vec3::Zero();
   double tail_thrust_estimate_ = 0;  // N, side force of the tail rotor
   double hover_tail_thrust_ = 0;     // N, its hover value, after a reset
