@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "ofn/rh_optimizer/occlusion.hpp"
 
 namespace ofn::rh {
@@ -70,6 +72,85 @@ TEST(VisibilityRecord, MarksWhatABeamCrossesNearFlightAltitudeOnly) {
   v.forget_beyond(Vec3(0, 0, 0), 10.0);
   EXPECT_TRUE(v.seen(5.5, 0.5));
   EXPECT_FALSE(v.seen(18.5, 0.5));
+}
+
+/// Level beams at flight altitude (30 m) from the vehicle at (0, 0) to every
+/// cell of `g` whose bearing is within `half_angle` of north, stopping at the
+/// first obstacle cell (a hit), as the yaw sweep would look.
+VisibilityRecord look_ahead(const mapping::Heightfield& g, double half_angle) {
+  VisibilityRecord seen(1.0, 3.0);
+  for (double bearing = -half_angle; bearing <= half_angle; bearing += 0.002) {
+    const Vec3 direction(std::cos(bearing), std::sin(bearing), 0.0);
+    double range = 0.5;
+    bool hit = false;
+    for (; range < 90.0; range += 0.25) {
+      const Vec3 p = range * direction;
+      const int r = g.row_of(p.x()), c = g.col_of(p.y());
+      if (!g.inside(r, c)) break;
+      if (g.at(r, c) > 0.0f) {
+        hit = true;
+        break;
+      }
+    }
+    seen.add_beam(Vec3(0, 0, -30), Vec3(range * direction.x(), range * direction.y(), -30), hit,
+                  30.0);
+  }
+  return seen;
+}
+
+TEST(UnseenExtension, AnObstacleSeenAtTheEdgeOfTheLookGoesOnIntoWhatWasNotSeen) {
+  // The corner of a low box hit at the edge of a +-20 deg look: the cells
+  // beside it that no beam crossed become obstacle of unknown height; the
+  // seen ones, those farther than the reach and those nearer the vehicle
+  // stay free.
+  mapping::Heightfield g = face(0.0f);
+  g.at(40, 44) = 25.0f;  // (40.5, 14.5): bearing 19.7 deg, the edge of the look
+  const VisibilityRecord seen = look_ahead(g, deg2rad(20.0));
+  ASSERT_TRUE(seen.seen(30.5, 0.5));    // straight ahead was looked at
+  ASSERT_FALSE(seen.seen(40.5, 17.5));  // beside the corner was not
+  const int raised =
+      extend_into_unseen(mapping::Heightfield(g), g, seen, Vec3(0, 0, -30), 3.0, 1.0f, 70.0f);
+  EXPECT_GT(raised, 5);
+  EXPECT_FLOAT_EQ(g.at(40, 44), 25.0f);  // the seen obstacle keeps its top
+  EXPECT_FLOAT_EQ(g.at(40, 47), 70.0f);  // 3 m beside it, unseen: unknown height
+  EXPECT_FLOAT_EQ(g.at(42, 46), 70.0f);
+  EXPECT_FLOAT_EQ(g.at(40, 48), 0.0f);  // beyond the reach
+  EXPECT_FLOAT_EQ(g.at(40, 40), 0.0f);  // inside the look: seen free
+  EXPECT_FLOAT_EQ(g.at(38, 45), 0.0f);  // nearer the vehicle than the corner
+  // Once a beam has crossed a cell it is free again.
+  mapping::Heightfield again = face(0.0f);
+  again.at(40, 44) = 25.0f;
+  const VisibilityRecord wider = look_ahead(again, deg2rad(40.0));
+  EXPECT_TRUE(wider.seen(40.5, 17.5));
+  extend_into_unseen(mapping::Heightfield(again), again, wider, Vec3(0, 0, -30), 3.0, 1.0f, 70.0f);
+  EXPECT_FLOAT_EQ(again.at(40, 47), 0.0f);
+}
+
+TEST(UnseenExtension, ShadowsNeitherExtendNorGrow) {
+  // A shadow cell (in the grid, not in the mapped cells) beside unseen
+  // space extends nothing, and an obstacle beside it does not raise it.
+  mapping::Heightfield mapped = face(0.0f);
+  mapped.at(40, 44) = 25.0f;
+  mapping::Heightfield grid = mapped;
+  grid.at(60, 30) = 40.0f;  // a shadow far from the obstacle
+  grid.at(41, 45) = 30.0f;  // a shadow right beside it
+  extend_into_unseen(mapped, grid, VisibilityRecord(), Vec3(0, 0, -30), 3.0, 1.0f, 70.0f);
+  EXPECT_FLOAT_EQ(grid.at(60, 33), 0.0f);
+  EXPECT_FLOAT_EQ(grid.at(41, 45), 30.0f);
+  EXPECT_FLOAT_EQ(grid.at(40, 47), 70.0f);  // the mapped obstacle still extends
+}
+
+TEST(UnseenExtension, NothingWithoutReachOrBelowTheObstacleTop) {
+  mapping::Heightfield g = face(0.0f);
+  g.at(40, 44) = 25.0f;
+  EXPECT_EQ(extend_into_unseen(mapping::Heightfield(g), g, VisibilityRecord(), Vec3(0, 0, -30), 0.0,
+                               1.0f, 70.0f),
+            0);
+  // A cell no higher than min_top is ground, not an obstacle to extend.
+  EXPECT_EQ(extend_into_unseen(mapping::Heightfield(g), g, VisibilityRecord(), Vec3(0, 0, -30), 3.0,
+                               25.0f, 70.0f),
+            0);
+  EXPECT_FLOAT_EQ(g.at(40, 47), 0.0f);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -141,6 +142,41 @@ int cast_occlusion_shadows(mapping::Heightfield& grid, const VisibilityRecord& v
       }
     }
   }
+  return raised;
+}
+
+int extend_into_unseen(const mapping::Heightfield& mapped, mapping::Heightfield& grid,
+                       const VisibilityRecord& visibility, const Vec3& vehicle, double reach,
+                       float min_top, float top) {
+  if (mapped.empty() || !(reach > 0)) return 0;
+  if (mapped.rows != grid.rows || mapped.cols != grid.cols)
+    throw std::invalid_argument("extend_into_unseen: the grids differ in size");
+  const int cells = static_cast<int>(std::floor(reach / mapped.resolution));
+  const double reach_cells = reach / mapped.resolution + 1e-9;
+  auto range = [&](int r, int c) {
+    return std::hypot(mapped.cell_centre_north(r) - vehicle.x(),
+                      mapped.cell_centre_east(c) - vehicle.y());
+  };
+  // Whether a beam crossed each cell, looked up once per cell: -1 not yet.
+  std::vector<int8_t> seen(mapped.top.size(), -1);
+  int raised = 0;
+  for (int row = 0; row < mapped.rows; ++row)
+    for (int col = 0; col < mapped.cols; ++col) {
+      if (!(mapped.at(row, col) > min_top)) continue;
+      const double obstacle_range = range(row, col) - 0.5 * mapped.resolution;
+      for (int dr = -cells; dr <= cells; ++dr)
+        for (int dc = -cells; dc <= cells; ++dc) {
+          const int r = row + dr, c = col + dc;
+          if (std::hypot(dr, dc) > reach_cells || !mapped.inside(r, c)) continue;
+          if (grid.at(r, c) > min_top || range(r, c) < obstacle_range) continue;
+          int8_t& looked = seen[static_cast<size_t>(r) * mapped.cols + c];
+          if (looked < 0)
+            looked = visibility.seen(mapped.cell_centre_north(r), mapped.cell_centre_east(c));
+          if (looked) continue;
+          grid.at(r, c) = top;
+          ++raised;
+        }
+    }
   return raised;
 }
 

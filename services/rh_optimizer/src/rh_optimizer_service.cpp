@@ -65,6 +65,7 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   c.field_altitude_band = r.number_in("field_altitude_band", c.field_altitude_band, 5.0, 1000.0);
   c.occlusion_depth = r.number_in("occlusion_depth", c.occlusion_depth, 0.0, 500.0);
   c.visibility_band = r.number_in("visibility_band", c.visibility_band, 0.1, 100.0);
+  c.unseen_extension = r.number_in("unseen_extension", c.unseen_extension, 0.0, 50.0);
   c.planned_initial_acceleration =
       r.boolean("planned_initial_acceleration", c.planned_initial_acceleration);
   c.planned_initial_state = r.boolean("planned_initial_state", c.planned_initial_state);
@@ -343,11 +344,20 @@ bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
   const double ground = config_.optimizer.ground_altitude;
   const double alt = vehicle_altitude - ground;
   if (config_.occlusion_depth > 0) {
+    if (config_.unseen_extension > 0) mapped_ = heightfield_;
     // Cast on the map alone (a shadow casts none of its own), then add
     // the shadows remembered from earlier viewpoints.
     cast_occlusion_shadows(heightfield_, visibility_, vehicle, alt, config_.occlusion_depth, 2.0,
                            &shadows_);
     shadows_.apply(heightfield_, visibility_);
+    // Beside what was mapped, what was not seen may be more of it, as tall
+    // as anything the field holds. Tops lower than 1 m are the ground (the
+    // mapper's ground_clearance), not obstacles to extend.
+    if (config_.unseen_extension > 0) {
+      const auto unknown_top = static_cast<float>(alt + config_.field_altitude_band);
+      extend_into_unseen(mapped_, heightfield_, visibility_, vehicle, config_.unseen_extension,
+                         1.0f, unknown_top);
+    }
   }
   const double lo = std::max(0.0, alt - config_.field_altitude_band);
   const double hi = std::max(lo + 1.0, alt + config_.field_altitude_band);

@@ -87,4 +87,25 @@ int cast_occlusion_shadows(mapping::Heightfield& grid, const VisibilityRecord& v
                            const Vec3& vehicle_ned, double vehicle_altitude, double depth,
                            double near = 2.0, ShadowMemory* memory = nullptr);
 
+/// An obstacle seen only at the edge of what the scanner has looked at may
+/// go on into the space it has not: beside the path, outside the sweep, a
+/// box's corner hit by the sweep's edge can be all that is seen of it, and
+/// its top only where the beams grazed the corner (dense field 7: a 123 ft
+/// box mapped as a 101 ft pillar at its corner and passed at 0.5 R_s). The
+/// shadows cover what lies behind a face along the line of sight, not what
+/// lies beside it. So every cell free in `grid` that no beam has crossed
+/// near flight altitude, within `reach` metres of an obstacle cell of
+/// `mapped` (top above `min_top`, m above ground) and no nearer to the
+/// vehicle than that cell, is raised in `grid` (the same cells, `mapped`
+/// with the shadows added) to `top`: its height is unknown. Cells nearer
+/// than the obstacle are left alone: the beams that met it came through
+/// them (a beam marks the cells it crosses only up to one short of its hit).
+/// Shadows neither extend nor grow: they are unseen space taken as
+/// obstacle already, and widening or raising them would close gaps and tops
+/// the scanner has looked through or over. It lasts only
+/// until a beam crosses the cell. Returns the number of cells raised.
+int extend_into_unseen(const mapping::Heightfield& mapped, mapping::Heightfield& grid,
+                       const VisibilityRecord& visibility, const Vec3& vehicle_ned, double reach,
+                       float min_top, float top);
+
 }  // namespace ofn::rh

@@ -43,6 +43,12 @@ struct RhOptimizerServiceConfig {
       30.0;  // m of hidden space behind a seen face taken as obstacle (0: none)
   double visibility_band =
       3.0;  // m around flight altitude in which a crossing beam counts as a look
+  /// m into unseen space beside an obstacle taken as obstacle of unknown
+  /// height (extend_into_unseen; 0: none; needs occlusion_depth > 0, which
+  /// turns the visibility record on). Off by default: at 3 m it removed the
+  /// dense fields' clearance violation but cost completeness, forward-speed
+  /// excursions and course time (docs/TUNING.md).
+  double unseen_extension = 0.0;
   bool planned_initial_acceleration = true;  // a(t0) from the last plan, not the nav solution
   /// Position and velocity at t0 from the last plan too, while the vehicle
   /// is within these errors of it. Starting every plan at the measured
@@ -136,6 +142,8 @@ class RhOptimizerService {
   ShadowMemory shadows_;
   int64_t scans_seen_ = 0;
   mapping::Heightfield heightfield_;
+  mapping::Heightfield
+      mapped_;  // heightfield_ before the shadows: what unseen extension starts from
   mapping::DistanceField field_;
   bool field_valid_ = false;
   Utime field_built_ = INT64_MIN;
