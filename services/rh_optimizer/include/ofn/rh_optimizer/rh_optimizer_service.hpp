@@ -142,8 +142,8 @@ class RhOptimizerService {
   ShadowMemory shadows_;
   int64_t scans_seen_ = 0;
   mapping::Heightfield heightfield_;
-  mapping::Heightfield
-      mapped_;  // heightfield_ before the shadows: what unseen extension starts from
+  // heightfield_ before the shadows: what the unseen extension starts from
+  mapping::Heightfield mapped_;
   mapping::DistanceField field_;
   bool field_valid_ = false;
   Utime field_built_ = INT64_MIN;
