@@ -130,8 +130,8 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.sweep.total_angle =
       deg2rad(sweep.number_in("total_deg", rad2deg(c.sweep.total_angle), 0.0, 180.0));
   c.sweep.scanner_timeout = sweep.number_in("scanner_timeout", c.sweep.scanner_timeout, 0.05, 60.0);
-  c.sweep.wide_total_angle = deg2rad(
-      sweep.number_in("wide_total_deg", rad2deg(c.sweep.wide_total_angle), 0.0, 180.0));
+  c.sweep.wide_total_angle =
+      deg2rad(sweep.number_in("wide_total_deg", rad2deg(c.sweep.wide_total_angle), 0.0, 180.0));
   c.sweep.widen_rate =
       deg2rad(sweep.number_in("widen_rate_deg_s", rad2deg(c.sweep.widen_rate), 0.1, 180.0));
   sweep.finish();
@@ -271,7 +271,7 @@ void ControllerService::on_lidar_scan() {
 }
 
 double ControllerService::yaw_reference(const std::optional<Vec3>& facing, bool looking_around,
-                                        double dt, double* yaw_rate) {
+                                        double horizontal_speed, double dt, double* yaw_rate) {
   // Face along the path; sweep the scanner while it runs.
   double yaw = path_heading_.update(facing, dt);
   // A look-around turns steadily at the heading's limit: fed forward, the
@@ -291,8 +291,8 @@ double ControllerService::yaw_reference(const std::optional<Vec3>& facing, bool 
       node_.log().info("scanner active: yaw sweep started");
     }
     // Wider while the vehicle is too slow to face where it goes.
-    const double speed = nav_ ? std::hypot(nav_->velocity[0], nav_->velocity[1]) : 0.0;
-    const double half = sweep_half_angle(config_.sweep, speed, config_.heading.min_speed);
+    const double half =
+        sweep_half_angle(config_.sweep, horizontal_speed, config_.heading.min_speed);
     double sweep_rate = 0;
     yaw += sweep_.update(half, dt, &sweep_rate);
     *yaw_rate += sweep_rate;
@@ -397,11 +397,11 @@ void ControllerService::control_step() {
                      static_cast<int>(mode_), to_seconds(now));
   const bool looking_around = mode_ == control_status_t::TRAJECTORY && ref_traj_ &&
                               ref_traj_->mode == ref_traj_t::LOOK_AROUND;
+  const double horizontal_speed = std::hypot(x.velocity.x(), x.velocity.y());
   // The networks learn in flight; at a hover and in a look-around the
   // heading turning over a vehicle that barely moves is all they would see.
-  controller_.hold_adaptation(looking_around ||
-                              std::hypot(x.velocity.x(), x.velocity.y()) < config_.heading.min_speed);
-  ref.yaw = yaw_reference(facing, looking_around, dt, &ref.yaw_rate);
+  controller_.hold_adaptation(looking_around || horizontal_speed < config_.heading.min_speed);
+  ref.yaw = yaw_reference(facing, looking_around, horizontal_speed, dt, &ref.yaw_rate);
   // Whatever chose it, the reference flown stays inside the envelope.
   bool clamped = false;
   ref = gate_.clamp(ref, flight_limits(), &clamped);

@@ -42,10 +42,21 @@ Vec3 look_around_facing(double yaw) {
   return Vec3(std::cos(ahead), std::sin(ahead), 0.0);
 }
 
+namespace {
+
+/// The sweep's half angles (rad): at cruise, and at the widest.
+double nominal_half_angle(const YawSweep& sweep) {
+  return 0.5 * sweep.total_angle;
+}
+double widest_half_angle(const YawSweep& sweep) {
+  return std::max(nominal_half_angle(sweep), 0.5 * sweep.wide_total_angle);
+}
+
+}  // namespace
+
 double sweep_half_angle(const YawSweep& sweep, double speed, double slow_speed) {
-  const double nominal = 0.5 * sweep.total_angle;
-  const double wide = std::max(nominal, 0.5 * sweep.wide_total_angle);
-  return std::isfinite(speed) && speed < slow_speed ? wide : nominal;
+  return std::isfinite(speed) && speed < slow_speed ? widest_half_angle(sweep)
+                                                    : nominal_half_angle(sweep);
 }
 
 void YawSweepGenerator::restart() {
@@ -56,8 +67,8 @@ void YawSweepGenerator::restart() {
 }
 
 double YawSweepGenerator::update(double target_half_angle, double dt, double* rate) {
-  const double nominal = 0.5 * sweep_.total_angle;
-  const double wide = std::max(nominal, 0.5 * sweep_.wide_total_angle);
+  const double nominal = nominal_half_angle(sweep_);
+  const double wide = widest_half_angle(sweep_);
   const double target = std::clamp(target_half_angle, nominal, wide);
   // How the half angle moves over the coming step.
   bool fade_ends = false;
