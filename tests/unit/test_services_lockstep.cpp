@@ -285,38 +285,50 @@ class TrajectoryFeeder {
   Vec3 position_;
 };
 
+/// The controller alone on the bus at the start of the open course's first
+/// leg: a navigation solution, trajectories from 1 s on, its status recorded.
+struct ControllerFedTrajectories {
+  explicit ControllerFedTrajectories(const control::ControllerConfig& config)
+      : open(load_scenario(kOpenScenario)),
+        nav(lockstep, open.waypoints.front().position),
+        feeder(lockstep, uplink::mission_from_scenario(open, 1), open.waypoints.front().position),
+        controller(lockstep.lcm(), lockstep.clock(), config),
+        recorder(lockstep) {
+    feeder.from = 1.0;
+    for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})
+      lockstep.add(*n);
+  }
+  sim::Lockstep lockstep;
+  Scenario open;
+  NavFeeder nav;
+  TrajectoryFeeder feeder;
+  control::ControllerService controller;
+  BusRecorder recorder;
+};
+
 TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
   // The vehicle faces north (the leg); from 1 s a trajectory heads east. The
   // heading turns at 30 deg/s, not in one step; a slow reference then holds
   // it wherever that reference points.
-  sim::Lockstep lockstep;
-  const Scenario open = load_scenario(kOpenScenario);
-  const Vec3 here = open.waypoints.front().position;
-  NavFeeder nav(lockstep, here);
-  TrajectoryFeeder feeder(lockstep, uplink::mission_from_scenario(open, 1), here);
-  feeder.from = 1.0;
-  feeder.velocity = Vec3(0, 3, 0);
+  const auto config = default_controller_config();
+  ASSERT_NEAR(rad2deg(config.heading.max_rate), 30.0, 1e-9);
+  ControllerFedTrajectories bus(config);
+  bus.feeder.velocity = Vec3(0, 3, 0);
   // The vehicle moves as each trajectory starts, so the controller takes
   // them (a plan starting off both the reference and the vehicle is a jump).
-  nav.velocity = feeder.velocity;
-  auto config = default_controller_config();
-  ASSERT_NEAR(rad2deg(config.heading.max_rate), 30.0, 1e-9);
-  control::ControllerService controller(lockstep.lcm(), lockstep.clock(), config);
-  BusRecorder recorder(lockstep);
-  for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})
-    lockstep.add(*n);
-  lockstep.run(to_utime(6.0));
-  feeder.velocity = Vec3(-0.5, -0.2, 0);  // slow, pointing elsewhere
-  nav.velocity = feeder.velocity;
-  lockstep.run(to_utime(9.0));
+  bus.nav.velocity = bus.feeder.velocity;
+  bus.lockstep.run(to_utime(6.0));
+  bus.feeder.velocity = Vec3(-0.5, -0.2, 0);  // slow, pointing elsewhere
+  bus.nav.velocity = bus.feeder.velocity;
+  bus.lockstep.run(to_utime(9.0));
 
   const auto yaw_at = [&](double t) {
-    for (const auto& s : recorder.status)
+    for (const auto& s : bus.recorder.status)
       if (to_seconds(s.utime) >= t) return rad2deg(s.yaw_reference);
     return std::numeric_limits<double>::quiet_NaN();
   };
   double turn_start = NAN;
-  for (const auto& s : recorder.status)
+  for (const auto& s : bus.recorder.status)
     if (s.mode == control_status_t::TRAJECTORY) {
       turn_start = to_seconds(s.utime);
       break;
@@ -327,10 +339,10 @@ TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
   EXPECT_NEAR(yaw_at(turn_start + 2.0), 60.0, 1.5);
   EXPECT_NEAR(yaw_at(5.5), 90.0, 1e-6);
   // Never faster than the limit between two status messages.
-  for (size_t i = 1; i < recorder.status.size(); ++i) {
-    const double dt = to_seconds(recorder.status[i].utime - recorder.status[i - 1].utime);
+  for (size_t i = 1; i < bus.recorder.status.size(); ++i) {
+    const double dt = to_seconds(bus.recorder.status[i].utime - bus.recorder.status[i - 1].utime);
     const double step =
-        std::abs(recorder.status[i].yaw_reference - recorder.status[i - 1].yaw_reference);
+        std::abs(bus.recorder.status[i].yaw_reference - bus.recorder.status[i - 1].yaw_reference);
     EXPECT_LE(step, config.heading.max_rate * dt + 1e-9) << "at " << i;
   }
   // Slow: the heading stays east.
@@ -342,45 +354,35 @@ TEST_F(LockstepServices, ALookAroundTurnsSteadilyAndAdaptationLearnsOnlyInFlight
   // heading turns at its rate limit, fed forward, with the adaptive
   // element's weights held (as at any hover); a plan flown at speed after it
   // releases them.
-  sim::Lockstep lockstep;
-  const Scenario open = load_scenario(kOpenScenario);
-  const Vec3 here = open.waypoints.front().position;
-  NavFeeder nav(lockstep, here);
-  TrajectoryFeeder feeder(lockstep, uplink::mission_from_scenario(open, 1), here);
-  feeder.from = 1.0;
-  feeder.mode = ref_traj_t::LOOK_AROUND;
-  auto config = default_controller_config();
-  control::ControllerService controller(lockstep.lcm(), lockstep.clock(), config);
-  BusRecorder recorder(lockstep);
-  for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})
-    lockstep.add(*n);
-  lockstep.run(to_utime(4.0));
-  EXPECT_EQ(controller.mode(), control_status_t::TRAJECTORY);
-  EXPECT_TRUE(controller.adaptation_held());
+  const auto config = default_controller_config();
+  ControllerFedTrajectories bus(config);
+  bus.feeder.mode = ref_traj_t::LOOK_AROUND;
+  bus.lockstep.run(to_utime(4.0));
+  EXPECT_EQ(bus.controller.mode(), control_status_t::TRAJECTORY);
+  EXPECT_TRUE(bus.controller.adaptation_held());
   // Turning at the limit: 30 deg/s between status messages, once turning.
-  ASSERT_GE(recorder.status.size(), 100u);
-  double largest_step = 0, turned = 0;
-  for (size_t i = 1; i < recorder.status.size(); ++i) {
-    if (to_seconds(recorder.status[i - 1].utime) < 1.5) continue;
-    const double dt = to_seconds(recorder.status[i].utime - recorder.status[i - 1].utime);
-    const double step = wrap_angle(recorder.status[i].yaw_reference -
-                                   recorder.status[i - 1].yaw_reference);
+  ASSERT_GE(bus.recorder.status.size(), 100u);
+  double turned = 0;
+  for (size_t i = 1; i < bus.recorder.status.size(); ++i) {
+    if (to_seconds(bus.recorder.status[i - 1].utime) < 1.5) continue;
+    const double dt = to_seconds(bus.recorder.status[i].utime - bus.recorder.status[i - 1].utime);
+    const double step =
+        wrap_angle(bus.recorder.status[i].yaw_reference - bus.recorder.status[i - 1].yaw_reference);
     EXPECT_NEAR(step, config.heading.max_rate * dt, 1e-9) << "at " << i;
-    largest_step = std::max(largest_step, std::abs(step));
     turned += step;
   }
   EXPECT_NEAR(rad2deg(turned), 30.0 * 2.5, 1.0);
   // A plan at cruise speed: learning resumes.
-  feeder.mode = ref_traj_t::AVOIDANCE;
-  feeder.velocity = nav.velocity = Vec3(3, 0, 0);
-  lockstep.run(to_utime(4.5));
-  EXPECT_EQ(controller.mode(), control_status_t::TRAJECTORY);
-  EXPECT_FALSE(controller.adaptation_held());
+  bus.feeder.mode = ref_traj_t::AVOIDANCE;
+  bus.feeder.velocity = bus.nav.velocity = Vec3(3, 0, 0);
+  bus.lockstep.run(to_utime(4.5));
+  EXPECT_EQ(bus.controller.mode(), control_status_t::TRAJECTORY);
+  EXPECT_FALSE(bus.controller.adaptation_held());
   // Creeping, slower than the path heading's min_speed: held again.
-  feeder.velocity = nav.velocity = Vec3(0.5, 0, 0);
-  lockstep.run(to_utime(5.0));
-  EXPECT_EQ(controller.mode(), control_status_t::TRAJECTORY);
-  EXPECT_TRUE(controller.adaptation_held());
+  bus.feeder.velocity = bus.nav.velocity = Vec3(0.5, 0, 0);
+  bus.lockstep.run(to_utime(5.0));
+  EXPECT_EQ(bus.controller.mode(), control_status_t::TRAJECTORY);
+  EXPECT_TRUE(bus.controller.adaptation_held());
 }
 
 /// The rejections of `node` whose kind contains `text`.
