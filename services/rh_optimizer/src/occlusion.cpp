@@ -7,27 +7,11 @@
 #include <utility>
 #include <vector>
 
+#include "ofn/mapper/cell_key.hpp"
+
 namespace ofn::rh {
-namespace {
-
-int64_t cell_key(double north, double east, double resolution) {
-  const int64_t r = static_cast<int64_t>(std::floor(north / resolution));
-  const int64_t c = static_cast<int64_t>(std::floor(east / resolution));
-  return (r << 32) ^ (c & 0xffffffffLL);
-}
-
-// Centre (north, east) of the cell a key names.
-std::pair<double, double> key_centre(int64_t key, double resolution) {
-  const int64_t row = key >> 32;
-  const int32_t col = static_cast<int32_t>(key & 0xffffffffLL);
-  return {(static_cast<double>(row) + 0.5) * resolution,
-          (static_cast<double>(col) + 0.5) * resolution};
-}
-
-}  // namespace
-
 int64_t VisibilityRecord::key(double north, double east) const {
-  return cell_key(north, east, resolution_);
+  return mapping::cell_key(north, east, resolution_);
 }
 
 void VisibilityRecord::add_beam(const Vec3& origin, const Vec3& end, bool hit,
@@ -60,14 +44,14 @@ void VisibilityRecord::add_beam(const Vec3& origin, const Vec3& end, bool hit,
 void VisibilityRecord::forget_beyond(const Vec3& centre, double radius) {
   const double r2 = radius * radius;
   for (auto it = cells_.begin(); it != cells_.end();) {
-    const auto [north, east] = key_centre(*it, resolution_);
+    const auto [north, east] = mapping::cell_key_centre(*it, resolution_);
     const double dn = north - centre.x(), de = east - centre.y();
     it = dn * dn + de * de > r2 ? cells_.erase(it) : std::next(it);
   }
 }
 
 int64_t ShadowMemory::key(double north, double east) const {
-  return cell_key(north, east, resolution_);
+  return mapping::cell_key(north, east, resolution_);
 }
 
 void ShadowMemory::remember(double north, double east, float top, double occluder_north,
@@ -79,7 +63,7 @@ void ShadowMemory::remember(double north, double east, float top, double occlude
 int ShadowMemory::apply(mapping::Heightfield& grid, const VisibilityRecord& visibility) {
   int raised = 0;
   for (auto it = tops_.begin(); it != tops_.end();) {
-    const auto [north, east] = key_centre(it->first, resolution_);
+    const auto [north, east] = mapping::cell_key_centre(it->first, resolution_);
     const Shadow& shadow = it->second;
     const int orow = grid.row_of(shadow.occluder_north), ocol = grid.col_of(shadow.occluder_east);
     const bool occluder_stands = grid.inside(orow, ocol) && grid.at(orow, ocol) >= shadow.top;
@@ -100,7 +84,7 @@ int ShadowMemory::apply(mapping::Heightfield& grid, const VisibilityRecord& visi
 void ShadowMemory::forget_beyond(const Vec3& centre, double radius) {
   const double r2 = radius * radius;
   for (auto it = tops_.begin(); it != tops_.end();) {
-    const auto [north, east] = key_centre(it->first, resolution_);
+    const auto [north, east] = mapping::cell_key_centre(it->first, resolution_);
     const double dn = north - centre.x(), de = east - centre.y();
     it = dn * dn + de * de > r2 ? tops_.erase(it) : std::next(it);
   }
