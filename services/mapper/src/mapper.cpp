@@ -17,6 +17,8 @@ constexpr double kSeenOverContinuationFree = 3.0;
 constexpr double kSeenOverContinuationHit = 1.0;
 /// Cells whose tops differ by no more than this (m) belong to one surface.
 constexpr float kSameSurface = 0.5f;
+/// Scans between clean-ups of the hit record.
+constexpr int64_t kHitSpreadCleanup = 64;
 
 }  // namespace
 
@@ -25,6 +27,7 @@ Mapper::Mapper(const MapperConfig& config)
       grid_(config.grid),
       confirmed_(config.grid),
       seen_over_(config.grid),
+      hit_spread_(config.grid.resolution),
       occupancy_(config.occupancy),
       extractor_(config.cuboids),
       database_(config.database) {}
@@ -38,6 +41,15 @@ void Mapper::set_vehicle_position(const Vec3& ned) {
 void Mapper::add_scan(const ScanInput& scan) {
   ++counters_.scans;
   counters_.points += grid_.insert_hits(scan.points);
+  if (config_.top_over_hits) {
+    // The obstacle hits the grid takes (not the ground's).
+    for (const auto& p : scan.points)
+      if (-p.z() - config_.grid.ground_altitude >= config_.grid.ground_clearance)
+        hit_spread_.add(p);
+    if (counters_.scans % kHitSpreadCleanup == 0)
+      hit_spread_.forget_beyond(
+          vehicle_, std::sqrt(2.0) * config_.grid.half_extent + config_.grid.resolution);
+  }
   if (config_.use_occupancy)
     occupancy_.insert_scan(scan.sensor_origin, scan.points, scan.free_ray_ends);
   seen_points_.clear();
@@ -82,7 +94,10 @@ void Mapper::trace_over_tops(const Vec3& origin, const Vec3& end, double min_con
       const float top = raw.at(row, col);
       if (top > 0.0f) {
         const double lowest = std::min(a0 + t_enter * (a1 - a0), a0 + t_exit * (a1 - a0));
-        if (lowest > top && lowest <= top + band)
+        if (lowest > top && lowest <= top + band &&
+            (!config_.top_over_hits ||
+             hit_spread_.straddled(raw.cell_centre_north(row), raw.cell_centre_east(col), origin,
+                                   end, config_.top_over_hits_margin)))
           seen_points.emplace_back(raw.cell_centre_north(row), raw.cell_centre_east(col),
                                    -(ground + top));
       }

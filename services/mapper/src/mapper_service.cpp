@@ -18,6 +18,8 @@ MapperServiceConfig load_mapper_config(YamlReader& r) {
   m.use_occupancy = r.boolean("use_occupancy", m.use_occupancy);
   m.confirm_probability = r.number_in("confirm_probability", m.confirm_probability, 0.5, 0.999);
   m.top_seen_band = r.number_in("top_seen_band", m.top_seen_band, 0.1, 100.0);
+  m.top_over_hits = r.boolean("top_over_hits", m.top_over_hits);
+  m.top_over_hits_margin = r.number_in("top_over_hits_margin", m.top_over_hits_margin, 0.0, 1.0);
   const double ground = r.number_in("ground_altitude", 0.0, -1e4, 1e4);
 
   YamlReader grid = r.child("grid");
