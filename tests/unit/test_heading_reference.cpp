@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -17,44 +18,79 @@ Vec3 direction(double yaw) {
   return Vec3(std::cos(yaw), std::sin(yaw), 0.0);
 }
 
-TEST(PathHeading, ARouteFlownBackTurnsAtTheBoundedRateNotAtOnce) {
+TEST(PathHeading, ARouteFlownBackTurnsAtTheBoundedRateAndAccelerationNotAtOnce) {
   PathHeading settings;
   settings.max_rate = deg2rad(30);
+  settings.max_accel = deg2rad(60);
   PathHeadingFilter heading(settings);
   heading.reset(0.0);
-  // Facing straight back: the heading must take 6 s, never step.
-  double previous = heading.yaw();
-  double seconds = 0;
+  // Facing straight back: the turn speeds up for 0.5 s, turns at 30 deg/s
+  // and slows for 0.5 s: 6.5 s in all, never a step in angle or rate.
+  double previous = heading.yaw(), previous_rate = 0;
+  double seconds = 0, fastest = 0;
   while (std::abs(wrap_angle(heading.yaw() - kPi)) > 1e-9 && seconds < 20) {
     heading.update(direction(kPi), kDt);
-    EXPECT_LE(std::abs(wrap_angle(heading.yaw() - previous)), settings.max_rate * kDt + 1e-12);
+    const double step = wrap_angle(heading.yaw() - previous);
+    EXPECT_LE(std::abs(step), settings.max_rate * kDt + 1e-12);
+    EXPECT_NEAR(heading.turn_rate(), step / kDt, 1e-9) << "the rate fed forward is the turn's";
+    EXPECT_LE(std::abs(heading.turn_rate() - previous_rate), settings.max_accel * kDt + 1e-12);
+    fastest = std::max(fastest, heading.turn_rate());
     previous = heading.yaw();
+    previous_rate = heading.turn_rate();
     seconds += kDt;
   }
-  EXPECT_NEAR(seconds, kPi / settings.max_rate, 2 * kDt);
+  EXPECT_NEAR(seconds, kPi / settings.max_rate + settings.max_rate / settings.max_accel, 3 * kDt);
+  EXPECT_NEAR(fastest, settings.max_rate, 1e-12);
+  EXPECT_LE(std::abs(heading.turn_rate()), settings.max_accel * kDt);  // the last step's
+  // Settled: it stays on the direction.
+  for (int i = 0; i < 100; ++i) heading.update(direction(kPi), kDt);
+  EXPECT_NEAR(wrap_angle(heading.yaw() - kPi), 0.0, 1e-9);
+  EXPECT_EQ(heading.turn_rate(), 0.0);
 }
 
 TEST(PathHeading, TurnsTheShortWayAcrossPlusMinusPi) {
-  PathHeadingFilter heading(PathHeading{deg2rad(30), 1.0});
+  PathHeadingFilter heading(PathHeading{deg2rad(30), deg2rad(60), 1.0});
   heading.reset(deg2rad(170));
-  for (int i = 0; i < 100; ++i) heading.update(direction(deg2rad(-170)), kDt);
-  // 20 deg the short way takes 0.67 s; the long way would still be at 140 deg.
+  for (int i = 0; i < 150; ++i) heading.update(direction(deg2rad(-170)), kDt);
+  // 20 deg the short way takes 1.17 s; the long way would still be far off.
   EXPECT_NEAR(wrap_angle(heading.yaw() - deg2rad(-170)), 0.0, 1e-9);
 }
 
+TEST(PathHeading, WithNothingLeftToFaceTheTurnSlowsToAStop) {
+  PathHeadingFilter heading(PathHeading{deg2rad(30), deg2rad(60), 1.0});
+  heading.reset(0.0);
+  for (int i = 0; i < 100; ++i) heading.update(direction(kPi / 2), kDt);
+  ASSERT_NEAR(heading.turn_rate(), deg2rad(30), 1e-12);
+  double previous_rate = heading.turn_rate();
+  for (int i = 0; i < 100; ++i) {
+    heading.update(std::nullopt, kDt);
+    EXPECT_LE(std::abs(heading.turn_rate() - previous_rate), deg2rad(60) * kDt + 1e-12);
+    previous_rate = heading.turn_rate();
+  }
+  EXPECT_EQ(heading.turn_rate(), 0.0);
+  const double held = heading.yaw();
+  heading.update(std::nullopt, kDt);
+  EXPECT_EQ(heading.yaw(), held);
+}
+
 // A look-around: always a quarter turn to the right of the heading, so the
-// filtered heading turns one way at its bounded rate, through a full turn
-// in 2 pi / max_rate.
+// filtered heading turns one way, speeding up to its bounded rate, through a
+// full turn in max_rate / max_accel / 2 + 2 pi / max_rate.
 TEST(PathHeading, ALookAroundTurnsAtTheBoundedRateThroughAFullTurn) {
   PathHeadingFilter filter;
   filter.reset(0.3);
-  const double rate = PathHeading{}.max_rate;
+  const PathHeading settings;
+  const double rate = settings.max_rate;
+  const double speeding_up = rate / settings.max_accel;
   double turned = 0, last = filter.yaw();
-  const int steps = static_cast<int>(std::ceil(2 * M_PI / rate / kDt));
+  const int steps = static_cast<int>(std::ceil((2 * M_PI / rate + 0.5 * speeding_up) / kDt));
   for (int i = 0; i < steps; ++i) {
     filter.update(look_around_facing(filter.yaw()), kDt);
     const double step = wrap_angle(filter.yaw() - last);
-    EXPECT_NEAR(step, rate * kDt, 1e-9);
+    if ((i + 1) * kDt > speeding_up + 1e-9) {
+      EXPECT_NEAR(step, rate * kDt, 1e-9) << "at " << i;
+    }
+    EXPECT_NEAR(filter.turn_rate(), step / kDt, 1e-9);
     turned += step;
     last = filter.yaw();
   }

@@ -308,10 +308,11 @@ struct ControllerFedTrajectories {
 
 TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
   // The vehicle faces north (the leg); from 1 s a trajectory heads east. The
-  // heading turns at 30 deg/s, not in one step; a slow reference then holds
-  // it wherever that reference points.
+  // heading speeds up over 0.5 s to turn at 30 deg/s, not in one step; a
+  // slow reference then holds it wherever that reference points.
   const auto config = default_controller_config();
   ASSERT_NEAR(rad2deg(config.heading.max_rate), 30.0, 1e-9);
+  ASSERT_NEAR(rad2deg(config.heading.max_accel), 60.0, 1e-9);
   ControllerFedTrajectories bus(config);
   bus.feeder.velocity = Vec3(0, 3, 0);
   // The vehicle moves as each trajectory starts, so the controller takes
@@ -335,8 +336,9 @@ TEST_F(LockstepServices, PathHeadingTurnsAtItsRateLimitAndHoldsWhenSlow) {
     }
   ASSERT_TRUE(std::isfinite(turn_start));
   EXPECT_NEAR(yaw_at(turn_start - 0.1), 0.0, 1e-6);
-  EXPECT_NEAR(yaw_at(turn_start + 1.0), 30.0, 1.5);
-  EXPECT_NEAR(yaw_at(turn_start + 2.0), 60.0, 1.5);
+  // 7.5 deg while speeding up over 0.5 s, then 30 deg/s.
+  EXPECT_NEAR(yaw_at(turn_start + 1.0), 22.5, 1.5);
+  EXPECT_NEAR(yaw_at(turn_start + 2.0), 52.5, 1.5);
   EXPECT_NEAR(yaw_at(5.5), 90.0, 1e-6);
   // Never faster than the limit between two status messages.
   for (size_t i = 1; i < bus.recorder.status.size(); ++i) {

@@ -138,6 +138,8 @@ ControllerConfig load_controller_config(YamlReader& r) {
   YamlReader heading = r.child("path_heading");
   c.heading.max_rate =
       deg2rad(heading.number_in("max_rate_deg_s", rad2deg(c.heading.max_rate), 1.0, 360.0));
+  c.heading.max_accel =
+      deg2rad(heading.number_in("max_accel_deg_s2", rad2deg(c.heading.max_accel), 1.0, 3600.0));
   c.heading.min_speed = heading.number_in("min_speed", c.heading.min_speed, 0.0, 20.0);
   c.heading.look_ahead = heading.number_in("look_ahead", c.heading.look_ahead, 0.0, 20.0);
   heading.finish();
@@ -270,14 +272,13 @@ void ControllerService::on_lidar_scan() {
   last_scan_ = node_.now();
 }
 
-double ControllerService::yaw_reference(const std::optional<Vec3>& facing, bool looking_around,
-                                        double horizontal_speed, double dt, double* yaw_rate) {
-  // Face along the path; sweep the scanner while it runs.
+double ControllerService::yaw_reference(const std::optional<Vec3>& facing, double horizontal_speed,
+                                        double dt, double* yaw_rate) {
+  // Face along the path; sweep the scanner while it runs. The path
+  // heading's turn rate is smooth (acceleration-limited): fed forward, a
+  // turn leaves no lag.
   double yaw = path_heading_.update(facing, dt);
-  // A look-around turns steadily at the heading's limit: fed forward, the
-  // turn leaves no lag. Elsewhere the facing direction moves with every new
-  // plan and its rate is not fed forward.
-  *yaw_rate = looking_around ? path_heading_.turn_rate() : 0.0;
+  *yaw_rate = path_heading_.turn_rate();
   const Utime now = node_.now();
   const bool scanner_on =
       last_scan_ != INT64_MIN && now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
@@ -401,7 +402,7 @@ void ControllerService::control_step() {
   // The networks learn in flight; at a hover and in a look-around the
   // heading turning over a vehicle that barely moves is all they would see.
   controller_.hold_adaptation(looking_around || horizontal_speed < config_.heading.min_speed);
-  ref.yaw = yaw_reference(facing, looking_around, horizontal_speed, dt, &ref.yaw_rate);
+  ref.yaw = yaw_reference(facing, horizontal_speed, dt, &ref.yaw_rate);
   // Whatever chose it, the reference flown stays inside the envelope.
   bool clamped = false;
   ref = gate_.clamp(ref, flight_limits(), &clamped);

@@ -7,17 +7,31 @@ namespace ofn::control {
 
 void PathHeadingFilter::reset(double yaw) {
   yaw_ = yaw;
+  turn_rate_ = 0;
   initialised_ = true;
 }
 
 double PathHeadingFilter::update(const std::optional<Vec3>& facing, double dt) {
-  turn_rate_ = 0;
+  if (!(dt > 0)) return yaw_;
+  const double accel = std::max(settings_.max_accel, 1e-6);
+  const double step = accel * dt;
+  // The rate wanted now: toward the direction, no faster than a turn that
+  // starts braking at max_accel from the next step can still stop on it
+  // (r dt + r^2 / 2a = |error|); none without a direction.
+  double wanted = 0;
   if (facing) {
-    const double step = wrap_angle(std::atan2(facing->y(), facing->x()) - yaw_);
-    const double limit = settings_.max_rate * dt;
-    yaw_ = wrap_angle(yaw_ + std::clamp(step, -limit, limit));
-    if (std::abs(step) >= limit && dt > 0) turn_rate_ = std::copysign(settings_.max_rate, step);
+    const double error = wrap_angle(std::atan2(facing->y(), facing->x()) - yaw_);
+    // The last step of a turn lands on the direction.
+    if (std::abs(error) <= step * dt && std::abs(turn_rate_) <= step) {
+      yaw_ = wrap_angle(yaw_ + error);
+      turn_rate_ = error / dt;
+      return yaw_;
+    }
+    const double stoppable = std::sqrt(step * step + 2.0 * accel * std::abs(error)) - step;
+    wanted = std::copysign(std::min(settings_.max_rate, stoppable), error);
   }
+  turn_rate_ = std::clamp(wanted, turn_rate_ - step, turn_rate_ + step);
+  yaw_ = wrap_angle(yaw_ + turn_rate_ * dt);
   return yaw_;
 }
 

@@ -67,10 +67,13 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
     ref.acceleration = g.acceleration;
     // As the service: face the leg (not a vertical one), sweep on top.
     ref.yaw = path_heading.update(facing_along(g.leg_direction, kMinLegHorizontal), dt);
+    ref.yaw_rate = path_heading.turn_rate();
     if (config.yaw_sweep && setup.sweep.enabled) {
       const double half = sweep_half_angle(
           setup.sweep, std::hypot(nav.velocity.x(), nav.velocity.y()), setup.heading.min_speed);
-      ref.yaw = wrap_angle(ref.yaw + sweep.update(half, dt, &ref.yaw_rate));
+      double sweep_rate = 0;
+      ref.yaw = wrap_angle(ref.yaw + sweep.update(half, dt, &sweep_rate));
+      ref.yaw_rate += sweep_rate;
     }
 
     VehicleEstimate x;

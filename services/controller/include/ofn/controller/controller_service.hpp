@@ -62,8 +62,8 @@ class ControllerService {
   Limits flight_limits() const;
   void control_step();
   void publish_status();
-  double yaw_reference(const std::optional<Vec3>& facing, bool looking_around,
-                       double horizontal_speed, double dt, double* yaw_rate);
+  double yaw_reference(const std::optional<Vec3>& facing, double horizontal_speed, double dt,
+                       double* yaw_rate);
 
   Node node_;
   ControllerConfig config_;

@@ -67,10 +67,16 @@ class YawSweepGenerator {
 /// when it is slow (a stop beside the waypoint turns it through tens of
 /// degrees in a second), and a mode or leg change steps the path direction
 /// (a route flown back turns it through 180 deg at once): the heading follows
-/// at a bounded rate and holds below a speed.
+/// at a bounded rate and a bounded yaw acceleration, and holds below a speed.
 struct PathHeading {
   double max_rate = deg2rad(30);  // rad/s the path heading turns at most
-  double min_speed = 1.0;         // m/s of reference velocity below which it holds
+  /// rad/s^2 the turn rate changes at most. A turn rate that steps (0 to
+  /// 30 deg/s in one step) gives the inner loop a yaw-rate step; during a
+  /// sideways stop that swings the flown velocity by 0.2 m/s across the
+  /// stop, and the inner adaptive element, learning from the transient,
+  /// diverged in simulation (test_stop_flown.cpp).
+  double max_accel = deg2rad(60);
+  double min_speed = 1.0;  // m/s of reference velocity below which it holds
   /// s ahead along a trajectory the vehicle faces: the scanner looks where
   /// the plan is going, not only where it goes now, so that the space a
   /// turning plan (and its stops) will enter has been seen before it gets
@@ -78,10 +84,12 @@ struct PathHeading {
   double look_ahead = 3.0;
 };
 
-/// The path heading, turned toward the direction to face by at most
-/// max_rate * dt per step. Short of its limit it gives no yaw-rate
-/// feed-forward: the direction of a sampled reference jumps a little with
-/// every new trajectory, and its difference quotient would be noise.
+/// The path heading: a double integrator driven toward the direction to
+/// face, its turn rate within max_rate and changing by at most
+/// max_accel * dt per step, slowing in time to stop on the direction (no
+/// overshoot beyond a step's worth). Its turn rate is its own smooth state,
+/// so it is fed forward; the direction itself (a sampled reference's,
+/// jumping a little with every new trajectory) is never differentiated.
 class PathHeadingFilter {
  public:
   explicit PathHeadingFilter(PathHeading settings = {}) : settings_(settings) {}
@@ -90,15 +98,15 @@ class PathHeadingFilter {
   /// (-pi, pi]).
   void reset(double yaw);
   bool initialised() const { return initialised_; }
-  /// One step: turn toward the horizontal direction `facing`, or hold the
-  /// heading without one (hovering, climbing straight up). Returns the
-  /// path heading in (-pi, pi].
+  /// One step: turn toward the horizontal direction `facing`, or, without
+  /// one (hovering, climbing straight up), bring the turn to a stop and hold
+  /// the heading. Returns the path heading in (-pi, pi].
   double update(const std::optional<Vec3>& facing, double dt);
   double yaw() const { return yaw_; }
-  /// rad/s: the rate of the last step while the heading turns at its limit
-  /// (a steady turn, as in a look-around), else 0. Fed forward, it removes
-  /// the lag a steady turn otherwise leaves (7 deg at 30 deg/s), which the
-  /// inner loop's adaptive element would keep learning from.
+  /// rad/s the heading turns at now (within max_rate, changing at most
+  /// max_accel per second). Fed forward, it removes the lag a turn otherwise
+  /// leaves (7 deg at 30 deg/s), which the inner loop's adaptive element
+  /// would learn from.
   double turn_rate() const { return turn_rate_; }
 
  private:
