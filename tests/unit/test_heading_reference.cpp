@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 
+#include "ofn/common/braking.hpp"
 #include "ofn/controller/heading_reference.hpp"
 
 namespace ofn::control {
@@ -199,14 +200,47 @@ TEST(YawSweepGenerator, WidensWhenAskedWithoutExceedingTheNominalPeakRate) {
 
 TEST(SweepHalfAngle, NominalWhileFacingWhereItGoesWideWhenSlower) {
   YawSweep sweep;  // +-20 deg, up to +-60 deg
-  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 3.048, 1.0), deg2rad(20));
-  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 1.0, 1.0), deg2rad(20));
-  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.99, 1.0), deg2rad(60));
-  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.0, 1.0), deg2rad(60));
-  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, std::nan(""), 1.0), deg2rad(20));
+  const SweepCoverage none;
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 3.048, 1.0, none), deg2rad(20));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 1.0, 1.0, none), deg2rad(20));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.99, 1.0, none), deg2rad(60));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.0, 1.0, none), deg2rad(60));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, std::nan(""), 1.0, none), deg2rad(20));
   // Widening off: total_angle only.
   sweep.wide_total_angle = sweep.total_angle;
-  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.0, 1.0), deg2rad(20));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.0, 1.0, none), deg2rad(20));
+}
+
+TEST(SweepHalfAngle, ReachesTheClearanceBesideThePathAtTheStoppingDistance) {
+  YawSweep sweep;
+  const SweepCoverage benchmarks{20 * 0.3048, 0.8 * 1.6 * 0.3048};  // R_s, 0.8 a_max
+  // At cruise: the scan plane at the half angle reaches R_s to the side at
+  // the stopping distance (12.0 m): +-27 deg, not +-20.
+  const double cruise = 3.048;
+  const double stopping =
+      stop_from(Vec3::Zero(), Vec3(cruise, 0, 0), benchmarks.deceleration).distance();
+  const double half = sweep_half_angle(sweep, cruise, 1.0, benchmarks);
+  EXPECT_NEAR(stopping * std::tan(half), benchmarks.clearance, 1e-9);
+  EXPECT_NEAR(rad2deg(half), 26.9, 0.1);
+  // Slower: a shorter stop, a wider sweep, up to cover_total_angle (below
+  // the slow speed, the wide one).
+  EXPECT_GT(sweep_half_angle(sweep, 2.9, 1.0, benchmarks), half);
+  EXPECT_LT(sweep_half_angle(sweep, 2.9, 1.0, benchmarks), deg2rad(30));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 2.0, 1.0, benchmarks), deg2rad(30));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 1.0, 1.0, benchmarks), deg2rad(30));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 0.9, 1.0, benchmarks), deg2rad(60));
+  sweep.cover_total_angle = deg2rad(200);
+  EXPECT_GT(sweep_half_angle(sweep, 2.0, 1.0, benchmarks), deg2rad(45));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 1.0, 1.0, benchmarks), deg2rad(60));
+  sweep.cover_total_angle = deg2rad(60);
+  // Faster: never narrower than the nominal sweep.
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, 10.0, 1.0, benchmarks), deg2rad(20));
+  // The rule off, or nothing to cover: the nominal sweep.
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, cruise, 1.0, SweepCoverage{}), deg2rad(20));
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, cruise, 1.0, SweepCoverage{std::nan(""), 0.39}),
+                   deg2rad(20));
+  sweep.cover_clearance = false;
+  EXPECT_DOUBLE_EQ(sweep_half_angle(sweep, cruise, 1.0, benchmarks), deg2rad(20));
 }
 
 }  // namespace

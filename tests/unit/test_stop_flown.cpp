@@ -28,6 +28,7 @@ namespace {
 constexpr double kSpeedLimit = 3.048;                   // m/s, 10 ft/s
 constexpr double kBraking = 0.8 * 1.6 * 0.3048;         // m/s^2: 0.8 of 1.6 ft/s^2
 constexpr double kAllowedReverse = 0.02 * kSpeedLimit;  // m/s
+constexpr double kClearance = 20 * 0.3048;              // m, R_s
 
 ControllerConfig shipped_config() {
   auto reader = YamlReader::load_file(std::string(OFN_SOURCE_DIR) + "/config/controller.yaml");
@@ -91,7 +92,8 @@ FlownVelocity fly(const ControllerConfig& config, const StopFlight& flight) {
     ref.yaw_rate = path_heading.turn_rate();
     const double horizontal = std::hypot(nav.velocity.x(), nav.velocity.y());
     controller.hold_adaptation(horizontal < config.heading.min_speed);
-    const double half = sweep_half_angle(config.sweep, horizontal, config.heading.min_speed);
+    const double half = sweep_half_angle(config.sweep, horizontal, config.heading.min_speed,
+                                         SweepCoverage{kClearance, kBraking});
     double sweep_rate = 0;
     ref.yaw = wrap_angle(ref.yaw + sweep.update(half, dt, &sweep_rate));
     ref.yaw_rate += sweep_rate;
@@ -178,9 +180,7 @@ TEST(StopFlown, ASteppedTurnRateSwingsTheVelocityAcrossTheStop) {
   // learning from the transient, diverged to metres per second).
   ControllerConfig config = shipped_config();
   config.heading.max_accel = 1e6;
-  const double v = largest_across_a_turning_stop(config);
-  std::printf("stepped across %.4f\n", v);
-  EXPECT_GT(v, 4.0 * kAllowedReverse);
+  EXPECT_GT(largest_across_a_turning_stop(config), 1.0);
 }
 
 }  // namespace

@@ -134,6 +134,9 @@ ControllerConfig load_controller_config(YamlReader& r) {
       deg2rad(sweep.number_in("wide_total_deg", rad2deg(c.sweep.wide_total_angle), 0.0, 180.0));
   c.sweep.widen_rate =
       deg2rad(sweep.number_in("widen_rate_deg_s", rad2deg(c.sweep.widen_rate), 0.1, 180.0));
+  c.sweep.cover_clearance = sweep.boolean("cover_clearance", c.sweep.cover_clearance);
+  c.sweep.cover_total_angle =
+      deg2rad(sweep.number_in("cover_total_deg", rad2deg(c.sweep.cover_total_angle), 1.0, 360.0));
   sweep.finish();
   YamlReader heading = r.child("path_heading");
   c.heading.max_rate =
@@ -291,9 +294,13 @@ double ControllerService::yaw_reference(const std::optional<Vec3>& facing, doubl
       sweep_.restart();
       node_.log().info("scanner active: yaw sweep started");
     }
-    // Wider while the vehicle is too slow to face where it goes.
+    // Wider while the vehicle is too slow to face where it goes, and as wide
+    // as seeing R_s beside the path at the stopping distance asks.
+    const Limits limits = flight_limits();
+    const SweepCoverage coverage{limits.clearance,
+                                 config_.selector.stop_accel_fraction * limits.max_accel};
     const double half =
-        sweep_half_angle(config_.sweep, horizontal_speed, config_.heading.min_speed);
+        sweep_half_angle(config_.sweep, horizontal_speed, config_.heading.min_speed, coverage);
     double sweep_rate = 0;
     yaw += sweep_.update(half, dt, &sweep_rate);
     *yaw_rate += sweep_rate;

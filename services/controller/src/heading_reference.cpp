@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ofn/common/braking.hpp"
+
 namespace ofn::control {
 
 void PathHeadingFilter::reset(double yaw) {
@@ -68,9 +70,18 @@ double widest_half_angle(const YawSweep& sweep) {
 
 }  // namespace
 
-double sweep_half_angle(const YawSweep& sweep, double speed, double slow_speed) {
-  return std::isfinite(speed) && speed < slow_speed ? widest_half_angle(sweep)
-                                                    : nominal_half_angle(sweep);
+double sweep_half_angle(const YawSweep& sweep, double speed, double slow_speed,
+                        const SweepCoverage& coverage) {
+  if (std::isfinite(speed) && speed < slow_speed) return widest_half_angle(sweep);
+  const double nominal = nominal_half_angle(sweep);
+  if (!sweep.cover_clearance || !std::isfinite(speed) || !(coverage.clearance > 0) ||
+      !std::isfinite(coverage.clearance) || !(coverage.deceleration > 0) ||
+      !std::isfinite(coverage.deceleration))
+    return nominal;
+  const double stopping =
+      stop_from(Vec3::Zero(), Vec3(speed, 0.0, 0.0), coverage.deceleration).distance();
+  const double widest = std::min(widest_half_angle(sweep), 0.5 * sweep.cover_total_angle);
+  return std::clamp(std::atan2(coverage.clearance, stopping), nominal, std::max(nominal, widest));
 }
 
 void YawSweepGenerator::restart() {

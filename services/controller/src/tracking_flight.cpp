@@ -69,8 +69,11 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
     ref.yaw = path_heading.update(facing_along(g.leg_direction, kMinLegHorizontal), dt);
     ref.yaw_rate = path_heading.turn_rate();
     if (config.yaw_sweep && setup.sweep.enabled) {
-      const double half = sweep_half_angle(
-          setup.sweep, std::hypot(nav.velocity.x(), nav.velocity.y()), setup.heading.min_speed);
+      const SweepCoverage coverage{scenario.limits.clearance,
+                                   setup.stop_accel_fraction * scenario.limits.max_accel};
+      const double half =
+          sweep_half_angle(setup.sweep, std::hypot(nav.velocity.x(), nav.velocity.y()),
+                           setup.heading.min_speed, coverage);
       double sweep_rate = 0;
       ref.yaw = wrap_angle(ref.yaw + sweep.update(half, dt, &sweep_rate));
       ref.yaw_rate += sweep_rate;

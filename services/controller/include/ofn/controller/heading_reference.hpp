@@ -30,12 +30,35 @@ struct YawSweep {
   /// rad, peak to peak, at the widest (hovering); total_angle: never widens.
   double wide_total_angle = deg2rad(120);
   double widen_rate = deg2rad(10);  // rad/s the half angle changes at most once faded in
+  /// Widen the sweep (up to cover_total_angle) so that the scan plane
+  /// reaches the clearance R_s beside the path at the distance the vehicle
+  /// needs to stop (SweepCoverage). At cruise on the benchmarks' limits that
+  /// is +-27 deg: +-20 deg reaches only 4.3 m to the side at the 12 m
+  /// stopping distance, and a dense field's cylinder 4.5 m beside a turning
+  /// path was never scanned (seed 23, docs/RESULTS.md).
+  bool cover_clearance = true;
+  /// rad, peak to peak: the widest that rule makes the sweep. Between 1 and
+  /// 2.5 m/s the rule asks for up to +-60 deg; swept that wide at speed,
+  /// where the adaptive element learns, the inner loop went into a roll
+  /// and pitch limit cycle of +-25 deg (dense seed 13). Slower than
+  /// min_speed the sweep is wide_total_angle whatever this is.
+  double cover_total_angle = deg2rad(60);
+};
+
+/// What the sweep keeps in view (YawSweep::cover_clearance): `clearance` m
+/// to either side of the path at the stopping distance from the vehicle's
+/// speed at `deceleration` m/s^2 (the stop of braking.hpp). A zero or
+/// non-finite entry: no such rule.
+struct SweepCoverage {
+  double clearance = 0;     // m
+  double deceleration = 0;  // m/s^2
 };
 
 /// Half angle (rad) of the sweep for a vehicle at horizontal `speed`: the
 /// wide one below `slow_speed` (the path heading's min_speed), else the
-/// nominal one.
-double sweep_half_angle(const YawSweep& sweep, double speed, double slow_speed);
+/// nominal one, or wider, up to cover_total_angle, as `coverage` asks.
+double sweep_half_angle(const YawSweep& sweep, double speed, double slow_speed,
+                        const SweepCoverage& coverage);
 
 /// The sweep's yaw offset over time: a(t) sin(phi(t)). The half angle a
 /// ramps from zero to the nominal one over one period (the commanded yaw and

@@ -50,6 +50,9 @@ struct TrackingSetup {
   // the yaw sweep over it.
   PathHeading heading;
   YawSweep sweep;
+  /// Of the scenario's acceleration limit: the stop whose distance the sweep
+  /// covers (the controller's reference_selector.stop_accel_fraction).
+  double stop_accel_fraction = 0.8;
 };
 
 /// Flies the scenario's waypoints (steady wind, disturbances, airframe
