@@ -92,10 +92,10 @@ FlownVelocity fly(const ControllerConfig& config, const StopFlight& flight) {
     ref.yaw_rate = path_heading.turn_rate();
     const double horizontal = std::hypot(nav.velocity.x(), nav.velocity.y());
     controller.hold_adaptation(horizontal < config.heading.min_speed);
-    const double half = sweep_half_angle(config.sweep, horizontal, config.heading.min_speed,
-                                         SweepCoverage{kClearance, kBraking});
     double sweep_rate = 0;
-    ref.yaw = wrap_angle(ref.yaw + sweep.update(half, dt, &sweep_rate));
+    ref.yaw = wrap_angle(ref.yaw + sweep.update_at_speed(horizontal, config.heading.min_speed,
+                                                         SweepCoverage{kClearance, kBraking}, dt,
+                                                         &sweep_rate));
     ref.yaw_rate += sweep_rate;
     const VehicleEstimate x{nav.position, nav.velocity, nav.attitude, nav.body_rates};
     const ControlOutput out = controller.step(ref, x, dt);

@@ -299,10 +299,9 @@ double ControllerService::yaw_reference(const std::optional<Vec3>& facing, doubl
     const Limits limits = flight_limits();
     const SweepCoverage coverage{limits.clearance,
                                  config_.selector.stop_accel_fraction * limits.max_accel};
-    const double half =
-        sweep_half_angle(config_.sweep, horizontal_speed, config_.heading.min_speed, coverage);
     double sweep_rate = 0;
-    yaw += sweep_.update(half, dt, &sweep_rate);
+    yaw += sweep_.update_at_speed(horizontal_speed, config_.heading.min_speed, coverage, dt,
+                                  &sweep_rate);
     *yaw_rate += sweep_rate;
   }
   return wrap_angle(yaw);

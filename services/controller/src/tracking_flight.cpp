@@ -71,11 +71,10 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
     if (config.yaw_sweep && setup.sweep.enabled) {
       const SweepCoverage coverage{scenario.limits.clearance,
                                    setup.stop_accel_fraction * scenario.limits.max_accel};
-      const double half =
-          sweep_half_angle(setup.sweep, std::hypot(nav.velocity.x(), nav.velocity.y()),
-                           setup.heading.min_speed, coverage);
       double sweep_rate = 0;
-      ref.yaw = wrap_angle(ref.yaw + sweep.update(half, dt, &sweep_rate));
+      ref.yaw = wrap_angle(
+          ref.yaw + sweep.update_at_speed(std::hypot(nav.velocity.x(), nav.velocity.y()),
+                                          setup.heading.min_speed, coverage, dt, &sweep_rate));
       ref.yaw_rate += sweep_rate;
     }
 

@@ -74,6 +74,12 @@ class YawSweepGenerator {
   /// One step of `dt` s toward `target_half_angle` (rad); returns the yaw
   /// offset and writes its rate to `rate`.
   double update(double target_half_angle, double dt, double* rate);
+  /// The same step toward the half angle its own settings give a vehicle
+  /// at horizontal `speed` (sweep_half_angle).
+  double update_at_speed(double speed, double slow_speed, const SweepCoverage& coverage, double dt,
+                         double* rate) {
+    return update(sweep_half_angle(sweep_, speed, slow_speed, coverage), dt, rate);
+  }
   double half_angle() const { return half_; }
 
  private:
