@@ -161,57 +161,63 @@ TEST(RhNlp, GradientsMatchCentralDifferences) {
   // The plain terminal rows, then every optional one (zero a(T) and the
   // stop at the target, whose rows follow the a(T) rows).
   for (const bool optional_rows : {false, true}) {
-    RhSettings settings;
-    settings.zero_terminal_accel = optional_rows;
-    RhNlp nlp(settings, BsplineBasis(settings.degree, settings.intervals));
-    // Near the wall and a little inside the planned clearance, so that the
-    // clearance gradient and its growing requirement are both exercised.
-    RhProblem problem = course_problem(course, feet(180, 0, 150));
-    problem.acceleration = Vec3(0.1, -0.05, -0.2);
-    problem.stop_at_target = optional_rows;
-    nlp.set_problem(problem);
-    ASSERT_LT(nlp.start_clearance(), problem.limits.clearance + settings.clearance_margin);
-    nlp.set_cost_scale(37.0);
+    for (const bool pitched : {false, true}) {
+      RhSettings settings;
+      settings.zero_terminal_accel = optional_rows;
+      RhNlp nlp(settings, BsplineBasis(settings.degree, settings.intervals));
+      // Near the wall and a little inside the planned clearance, so that the
+      // clearance gradient and its growing requirement are both exercised.
+      RhProblem problem = course_problem(course, feet(180, 0, 150));
+      // A climbing leg's frame too: the vertical speed rows are the world's.
+      if (pitched)
+        problem.frame =
+            GuidanceFrame::from_leg(problem.position, problem.position + Vec3(8, 3, -6));
+      problem.acceleration = Vec3(0.1, -0.05, -0.2);
+      problem.stop_at_target = optional_rows;
+      nlp.set_problem(problem);
+      ASSERT_LT(nlp.start_clearance(), problem.limits.clearance + settings.clearance_margin);
+      nlp.set_cost_scale(37.0);
 
-    const InitialGuess guess = RhOptimizer::guess_from_path(course.route, problem, 3.0);
-    const Eigen::VectorXd base = nlp.fit(guess);
-    std::mt19937 rng(11);
-    std::normal_distribution<double> noise(0.0, 0.2);
-    const int n = nlp.num_variables();
-    const int mi = nlp.num_inequalities(), me = nlp.num_equalities();
-    for (int trial = 0; trial < 4; ++trial) {
-      Eigen::VectorXd z = base;
-      for (int j = 0; j < n; ++j) z(j) += noise(rng);
-      z(n - 1) = std::max(z(n - 1), 0.5);
-      Eigen::VectorXd gradient(n), ineq(mi), eq(me);
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> ji(mi, n), je(me, n);
-      nlp.objective(z.data(), gradient.data());
-      nlp.inequalities(z.data(), ineq.data(), ji.data());
-      nlp.equalities(z.data(), eq.data(), je.data());
-      const double h = 1e-6;
-      for (int j = 0; j < n; ++j) {
-        Eigen::VectorXd plus = z, minus = z;
-        plus(j) += h;
-        minus(j) -= h;
-        Eigen::VectorXd ip(mi), im(mi), ep(me), em(me);
-        const double fp = nlp.objective(plus.data(), nullptr);
-        nlp.inequalities(plus.data(), ip.data(), nullptr);
-        nlp.equalities(plus.data(), ep.data(), nullptr);
-        const double fm = nlp.objective(minus.data(), nullptr);
-        nlp.inequalities(minus.data(), im.data(), nullptr);
-        nlp.equalities(minus.data(), em.data(), nullptr);
-        const double df = (fp - fm) / (2 * h);
-        EXPECT_NEAR(gradient(j), df, 1e-4 * std::max(1.0, std::abs(df)))
-            << "cost, variable " << j << " trial " << trial;
-        for (int r = 0; r < mi; ++r) {
-          const double d = (ip(r) - im(r)) / (2 * h);
-          EXPECT_NEAR(ji(r, j), d, 1e-4 * std::max(1.0, std::abs(d)))
-              << "inequality " << r << " variable " << j << " trial " << trial;
-        }
-        for (int r = 0; r < me; ++r) {
-          const double d = (ep(r) - em(r)) / (2 * h);
-          EXPECT_NEAR(je(r, j), d, 1e-4 * std::max(1.0, std::abs(d)))
-              << "equality " << r << " variable " << j << " trial " << trial;
+      const InitialGuess guess = RhOptimizer::guess_from_path(course.route, problem, 3.0);
+      const Eigen::VectorXd base = nlp.fit(guess);
+      std::mt19937 rng(11);
+      std::normal_distribution<double> noise(0.0, 0.2);
+      const int n = nlp.num_variables();
+      const int mi = nlp.num_inequalities(), me = nlp.num_equalities();
+      for (int trial = 0; trial < 4; ++trial) {
+        Eigen::VectorXd z = base;
+        for (int j = 0; j < n; ++j) z(j) += noise(rng);
+        z(n - 1) = std::max(z(n - 1), 0.5);
+        Eigen::VectorXd gradient(n), ineq(mi), eq(me);
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> ji(mi, n), je(me, n);
+        nlp.objective(z.data(), gradient.data());
+        nlp.inequalities(z.data(), ineq.data(), ji.data());
+        nlp.equalities(z.data(), eq.data(), je.data());
+        const double h = 1e-6;
+        for (int j = 0; j < n; ++j) {
+          Eigen::VectorXd plus = z, minus = z;
+          plus(j) += h;
+          minus(j) -= h;
+          Eigen::VectorXd ip(mi), im(mi), ep(me), em(me);
+          const double fp = nlp.objective(plus.data(), nullptr);
+          nlp.inequalities(plus.data(), ip.data(), nullptr);
+          nlp.equalities(plus.data(), ep.data(), nullptr);
+          const double fm = nlp.objective(minus.data(), nullptr);
+          nlp.inequalities(minus.data(), im.data(), nullptr);
+          nlp.equalities(minus.data(), em.data(), nullptr);
+          const double df = (fp - fm) / (2 * h);
+          EXPECT_NEAR(gradient(j), df, 1e-4 * std::max(1.0, std::abs(df)))
+              << "cost, variable " << j << " trial " << trial;
+          for (int r = 0; r < mi; ++r) {
+            const double d = (ip(r) - im(r)) / (2 * h);
+            EXPECT_NEAR(ji(r, j), d, 1e-4 * std::max(1.0, std::abs(d)))
+                << "inequality " << r << " variable " << j << " trial " << trial;
+          }
+          for (int r = 0; r < me; ++r) {
+            const double d = (ep(r) - em(r)) / (2 * h);
+            EXPECT_NEAR(je(r, j), d, 1e-4 * std::max(1.0, std::abs(d)))
+                << "equality " << r << " variable " << j << " trial " << trial;
+          }
         }
       }
     }
@@ -289,6 +295,32 @@ TEST(RhOptimizer, AStartAboveTheAccelerationReserveIsBroughtInsideIt) {
   const double first_point = report.trajectory.duration() / settings.collocation_points;
   for (int i = 0; i <= 20; ++i)
     EXPECT_LE(report.trajectory.acceleration(first_point * i / 20).norm(), 1.005 * reserve);
+}
+
+TEST(RhOptimizer, AClimbingLegKeepsTheWorldsVerticalSpeedLimit) {
+  // An escape over a wall: a leg that climbs 20 m over 5 m, flown from a
+  // hover to a stop at its end. Its guidance frame is pitched, so its z is
+  // not the vertical; the vertical speed limit is the world's.
+  const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
+  RhOptimizer optimizer;
+  RhProblem problem;
+  problem.position = Vec3(0.0, 0.0, -30.0);
+  problem.target = Vec3(5.0, 0.0, -50.0);
+  problem.frame = GuidanceFrame::from_leg(problem.position, problem.target);
+  problem.limits = open.limits;
+  problem.terminal_x = problem.frame.to_guidance(problem.target).x();
+  problem.stop_at_target = true;
+  const SolveReport report = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
+  expect_meets_constraints(optimizer, problem, report, "climbing leg");
+  const double T = report.trajectory.duration();
+  EXPECT_LT((report.trajectory.position(T) - problem.target).norm(), 0.05);
+  double fastest_climb = 0;
+  for (int i = 0; i <= 400; ++i)
+    fastest_climb = std::max(fastest_climb, -report.trajectory.velocity(T * i / 400).z());
+  // It climbs at the limit (the speed along the leg alone would allow
+  // twice that), and not above it beyond the resampling tolerance.
+  EXPECT_LE(fastest_climb, 1.01 * open.limits.max_vertical_speed);
+  EXPECT_GT(fastest_climb, 0.9 * open.limits.max_vertical_speed);
 }
 
 TEST(RhOptimizer, StopsAtRestOnTheLastWaypoint) {

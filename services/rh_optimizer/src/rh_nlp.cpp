@@ -102,8 +102,13 @@ void PointConstraintModel::evaluate(const std::array<Vec3, 4>& state, double t, 
   }
 
   out.value[kForwardSpeedRow] = (min_forward_speed_ - velocity.x()) / max_speed_;
-  out.value[kClimbSpeedRow] = (-velocity.z() - max_vertical_speed_) / max_vertical_speed_;
-  out.value[kDescentSpeedRow] = (velocity.z() - max_vertical_speed_) / max_vertical_speed_;
+  // The vertical speed limit is the world's: on a climbing or descending leg
+  // (an escape over a wall) the guidance frame is pitched and its z axis is
+  // not the vertical. Held on the guidance z, a steep escape climbed faster
+  // than the limit and the commit gate refused every plan.
+  const double down_speed = world_from_guidance_.row(2).dot(velocity);
+  out.value[kClimbSpeedRow] = (-down_speed - max_vertical_speed_) / max_vertical_speed_;
+  out.value[kDescentSpeedRow] = (down_speed - max_vertical_speed_) / max_vertical_speed_;
   out.value[kTotalSpeedRow] = velocity.squaredNorm() / (max_speed_ * max_speed_) - 1.0;
   const double accel_sq = max_accel_ * max_accel_;
   out.value[kAccelerationRow] = accel.squaredNorm() / accel_sq - 1.0;
@@ -114,8 +119,8 @@ void PointConstraintModel::evaluate(const std::array<Vec3, 4>& state, double t, 
 
   if (!with_partials) return;
   out.partial[kForwardSpeedRow](1, 0) = -1.0 / max_speed_;
-  out.partial[kClimbSpeedRow](1, 2) = -1.0 / max_vertical_speed_;
-  out.partial[kDescentSpeedRow](1, 2) = 1.0 / max_vertical_speed_;
+  out.partial[kClimbSpeedRow].row(1) = -world_from_guidance_.row(2) / max_vertical_speed_;
+  out.partial[kDescentSpeedRow].row(1) = world_from_guidance_.row(2) / max_vertical_speed_;
   out.partial[kTotalSpeedRow].row(1) = 2.0 * velocity.transpose() / (max_speed_ * max_speed_);
   out.partial[kAccelerationRow].row(2) = 2.0 * accel.transpose() / accel_sq;
   out.partial[kCommandedAccelerationRow].row(2) = 2.0 * commanded.transpose() / accel_sq;

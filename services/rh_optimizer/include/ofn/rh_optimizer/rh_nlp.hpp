@@ -26,7 +26,7 @@ namespace ofn::rh {
 enum PointConstraint {
   kClearanceRow = 0,
   kForwardSpeedRow,
-  kClimbSpeedRow,    // -w <= max_vertical_speed
+  kClimbSpeedRow,    // -w <= max_vertical_speed (w: the world's down speed)
   kDescentSpeedRow,  // w <= max_vertical_speed
   kTotalSpeedRow,
   kAccelerationRow,
