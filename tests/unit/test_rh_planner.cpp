@@ -86,12 +86,41 @@ TEST(RhPlanner, APlanThatWaitsBeforeItMovesOffIsAStall) {
   const BsplineTrajectory goes =
       quadratic({start, start + (far - start) / 3, start + 2 * (far - start) / 3, far}, 20.0);
   EXPECT_FALSE(plan_stalled(goes, problem));
-  // A stop at the last waypoint ends near its start: not a stall.
-  const Vec3 near = start + Vec3(5, 0, 0);
+  // A short leg that waits is a stall too: an escape 8 m to the side.
+  const Vec3 aside = start + Vec3(-1, 8, 0);
+  EXPECT_TRUE(plan_stalled(quadratic({start, start, start, aside}, 20.0), problem));
+  // A stop at the last waypoint that ends near its start: not a stall.
+  const Vec3 near = start + Vec3(2, 0, 0);
   EXPECT_FALSE(plan_stalled(quadratic({start, start, start, near}, 20.0), problem));
   // The vehicle itself still moving: not a stall either (the plan brakes).
   problem.velocity = Vec3(kLimits.max_speed, 0, 0);
   EXPECT_FALSE(plan_stalled(waits, problem));
+}
+
+TEST(RhPlanner, AShortStopFromAHoverIsSolvedColdAndMovesOffInTime) {
+  // A hover a few metres before the last waypoint (after a look round or an
+  // escape), with no route to guess from: the straight guess speeds up and
+  // slows down. At constant speed it asked for a step in velocity and no
+  // stop 1-5 m on was solved. And the stall's least displacement is set so
+  // that a healthy plan to a stop just beyond it is no longer slow at the
+  // look-ahead.
+  for (const double distance : {1.0, 2.0, kStallMinDisplacement + 0.1, 5.0}) {
+    RhPlanner planner;
+    StepInput in = input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({}));
+    in.problem.velocity = Vec3::Zero();
+    in.problem.target = in.problem.position + Vec3(distance, 0, 0);
+    in.problem.terminal_x = in.problem.frame.to_guidance(in.problem.target).x();
+    in.problem.stop_at_target = true;
+    const StepOutput out = planner.step(in);
+    ASSERT_EQ(out.mode, StepMode::kSolved) << distance << " m: " << out.reason;
+    const double T = out.trajectory.duration();
+    EXPECT_LT((out.trajectory.position(T) - in.problem.target).norm(), 0.05) << distance << " m";
+    if (distance > kStallMinDisplacement) {
+      EXPECT_FALSE(plan_stalled(out.trajectory, in.problem))
+          << distance << " m, speed 3 s on: " << out.trajectory.velocity(kStallLookAhead).norm()
+          << " m/s";
+    }
+  }
 }
 
 TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {

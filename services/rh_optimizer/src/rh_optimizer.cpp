@@ -172,6 +172,42 @@ void sample_guess(const BsplineTrajectory* trajectory, double from, double until
   }
 }
 
+/// Guess along a polyline route (world NED, from the vehicle) under a
+/// SpeedProfile: from the vehicle's speed along the first step up to
+/// `speed`, down to rest at the end when the plan stops at its target.
+/// Empty when the route has no length.
+InitialGuess guess_along(const std::vector<Vec3>& route, const RhProblem& problem, double speed) {
+  std::vector<double> cumulative{0.0};
+  for (size_t i = 1; i < route.size(); ++i)
+    cumulative.push_back(cumulative.back() + (route[i] - route[i - 1]).norm());
+  const double length = cumulative.back();
+  if (length < 1e-3) return {};
+
+  // Along the route at `speed`; from a slower vehicle (a hover before an
+  // escape) it speeds up first, and a plan that stops at its target slows
+  // down at the end: a constant pace would ask for a step in velocity there,
+  // which SLSQP may not smooth out within the acceleration limits.
+  // It starts at the vehicle's speed along the route's first step: a route
+  // that turns away from the velocity starts slower.
+  const Vec3 first = route.size() > 1 ? (route[1] - route[0]).normalized() : Vec3::UnitX();
+  const SpeedProfile profile(std::clamp(problem.velocity.dot(first), 0.0, speed), speed,
+                             kGuessAccelFraction * problem.limits.max_accel, length,
+                             problem.stop_at_target);
+  InitialGuess guess;
+  guess.duration = profile.duration();
+  guess.positions.resize(kGuessSamples);
+  size_t segment = 0;
+  for (int k = 0; k < kGuessSamples; ++k) {
+    const double at = profile.distance(guess.duration * k / (kGuessSamples - 1));
+    while (segment + 2 < route.size() && cumulative[segment + 1] < at) ++segment;
+    const double span = cumulative[segment + 1] - cumulative[segment];
+    const double w = span > 0 ? std::clamp((at - cumulative[segment]) / span, 0.0, 1.0) : 0.0;
+    guess.positions[static_cast<size_t>(k)] =
+        route[segment] + w * (route[segment + 1] - route[segment]);
+  }
+  return guess;
+}
+
 }  // namespace
 
 const char* nlopt_result_name(int result) {
@@ -523,35 +559,9 @@ InitialGuess RhOptimizer::guess_from_path(const std::vector<Vec3>& path, const R
     if (remaining > 0) append(route.back() + frame.world_from_guidance.col(0) * remaining);
   }
 
-  std::vector<double> cumulative{0.0};
-  for (size_t i = 1; i < route.size(); ++i)
-    cumulative.push_back(cumulative.back() + (route[i] - route[i - 1]).norm());
-  const double length = cumulative.back();
-  if (length < 1e-3) return guess_straight(problem);
-
-  // Along the route at `speed`; from a slower vehicle (a hover before an
-  // escape) it speeds up first, and a plan that stops at its target slows
-  // down at the end: a constant pace would ask for a step in velocity there,
-  // which SLSQP may not smooth out within the acceleration limits.
-  // It starts at the vehicle's speed along the route's first step: a route
-  // that turns away from the velocity starts slower.
-  const Vec3 first = route.size() > 1 ? (route[1] - route[0]).normalized() : Vec3::UnitX();
-  const SpeedProfile profile(std::clamp(problem.velocity.dot(first), 0.0, speed), speed,
-                             kGuessAccelFraction * problem.limits.max_accel, length,
-                             problem.stop_at_target);
-  InitialGuess guess;
-  guess.duration = profile.duration();
-  guess.positions.resize(kGuessSamples);
-  size_t segment = 0;
-  for (int k = 0; k < kGuessSamples; ++k) {
-    const double at = profile.distance(guess.duration * k / (kGuessSamples - 1));
-    while (segment + 2 < route.size() && cumulative[segment + 1] < at) ++segment;
-    const double span = cumulative[segment + 1] - cumulative[segment];
-    const double w = span > 0 ? std::clamp((at - cumulative[segment]) / span, 0.0, 1.0) : 0.0;
-    guess.positions[static_cast<size_t>(k)] =
-        route[segment] + w * (route[segment + 1] - route[segment]);
-  }
-  return guess;
+  if (InitialGuess guess = guess_along(route, problem, speed); !guess.positions.empty())
+    return guess;
+  return guess_straight(problem);
 }
 
 InitialGuess RhOptimizer::guess_straight(const RhProblem& problem) {
@@ -560,6 +570,15 @@ InitialGuess RhOptimizer::guess_straight(const RhProblem& problem) {
   const Vec3 leg = problem.frame.world_from_guidance.col(0);
   const double distance =
       std::max(problem.terminal_x - problem.frame.to_guidance(problem.position).x(), speed * 1.0);
+  // Profiled like a route's guess (from the vehicle's speed, to rest on the
+  // target when the plan stops there). At constant speed a short plan from
+  // a hover asked for a step in velocity: from rest to a stop 1-5 m on, no
+  // cold solve found a feasible point.
+  const Vec3 end =
+      problem.stop_at_target ? problem.target : Vec3(problem.position + leg * distance);
+  if (InitialGuess guess = guess_along({problem.position, end}, problem, speed);
+      !guess.positions.empty())
+    return guess;
   InitialGuess guess;
   sample_guess(nullptr, 0, 0, problem.position, leg * speed, distance / speed, guess);
   return guess;

@@ -154,7 +154,9 @@ class RhOptimizer {
   /// nearest the vehicle up to terminal_x, flown at `speed`.
   static InitialGuess guess_from_path(const std::vector<Vec3>& path, const RhProblem& problem,
                                       double speed);
-  /// Straight along the leg at the current speed (at least half the max).
+  /// Straight along the leg (to the target when the plan stops there) at
+  /// the current speed (at least half the max), speeding up from the
+  /// vehicle's speed and slowing to rest as guess_from_path does.
   static InitialGuess guess_straight(const RhProblem& problem);
 
   const RhSettings& settings() const { return settings_; }

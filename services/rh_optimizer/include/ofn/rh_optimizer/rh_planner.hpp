@@ -35,10 +35,14 @@ struct FallbackSettings {
 /// ft/s^2 through the 0.5 s acceleration lag reaches 1.1 m/s in 3 s, against
 /// 0.3 m/s for "slow"); the speed threshold is capped at a quarter of what
 /// the acceleration limit reaches in that time for weaker limits. A plan
-/// that ends near its start (a stop at the last waypoint) is not a stall.
-constexpr double kStallLookAhead = 3.0;         // s
-constexpr double kStallSpeedFraction = 0.1;     // of limits.max_speed
-constexpr double kStallMinDisplacement = 10.0;  // m
+/// that ends near its start (a stop at the last waypoint a few metres on)
+/// is not a stall: from rest it may still be slow 3 s on. Beyond 3 m it is
+/// not (at 0.39 m/s^2 through the lag it is past 0.3 m/s by then). With 10
+/// m, an escape leg of 8 m went unchecked and its warm plans waited and
+/// wiggled for 100 s on random dense field 38.
+constexpr double kStallLookAhead = 3.0;        // s
+constexpr double kStallSpeedFraction = 0.1;    // of limits.max_speed
+constexpr double kStallMinDisplacement = 3.0;  // m
 bool plan_stalled(const BsplineTrajectory& trajectory, const RhProblem& problem);
 
 enum class StepMode { kSolved, kKeptPrevious, kBraking };
