@@ -215,10 +215,12 @@ TEST(SweepHalfAngle, ReachesTheClearanceBesideThePathAtTheStoppingDistance) {
   YawSweep sweep;
   const SweepCoverage benchmarks{20 * 0.3048, 0.8 * 1.6 * 0.3048};  // R_s, 0.8 a_max
   // At cruise: the scan plane at the half angle reaches R_s to the side at
-  // the stopping distance (12.0 m): +-27 deg, not +-20.
+  // the stopping distance (12.0 m, the stop without its onset): +-27 deg,
+  // not +-20.
   const double cruise = 3.048;
   const double stopping =
-      stop_from(Vec3::Zero(), Vec3(cruise, 0, 0), benchmarks.deceleration).distance();
+      stop_from(Vec3::Zero(), Vec3(cruise, 0, 0), benchmarks.deceleration, kStopRampTime, 0.0)
+          .distance();
   const double half = sweep_half_angle(sweep, cruise, 1.0, benchmarks);
   EXPECT_NEAR(stopping * std::tan(half), benchmarks.clearance, 1e-9);
   EXPECT_NEAR(rad2deg(half), 26.9, 0.1);

@@ -50,24 +50,28 @@ TEST(ReferenceSelector, AStalePlanIsFollowedByItsStopAndAHover) {
   selector.plan_flown();
   ASSERT_TRUE(selector.avoiding());
   const double max_accel = 0.4877;
-  const Reference flown = at(Vec3(10, 0, -30), Vec3(3.0, 0, 0));
+  Reference flown = at(Vec3(10, 0, -30), Vec3(3.0, 0, 0));
+  flown.acceleration = Vec3(0.2, 0, 0);  // still speeding up
   const Reference first = selector.safe_stop(100.0, flown, max_accel);
   EXPECT_TRUE(selector.stopping());
   EXPECT_LT((first.position - flown.position).norm(), 1e-12);  // continuous
   EXPECT_LT((first.velocity - flown.velocity).norm(), 1e-12);
-  EXPECT_NEAR(first.acceleration.x(), -0.8 * max_accel, 1e-12);
+  EXPECT_LT((first.acceleration - flown.acceleration).norm(), 1e-12);
   // The stop is fixed at its start: later calls ignore the reference passed.
-  // It is braking.hpp's: constant deceleration, then the ease-out.
-  const StopProfile expected = stop_from(flown.position, flown.velocity, 0.8 * max_accel);
+  // It is braking.hpp's: the onset from the reference's acceleration,
+  // constant deceleration, then the ease-out.
+  const StopProfile expected =
+      stop_from(flown.position, flown.velocity, flown.acceleration, 0.8 * max_accel);
   const Reference end = selector.safe_stop(100.0 + expected.stop_time + 5.0,
                                            at(Vec3::Zero(), Vec3::Zero()), max_accel);
   EXPECT_NEAR(end.position.x(), expected.stop_point().x(), 1e-9);
   EXPECT_GT(end.position.x(), 10.0 + 3.0 * 3.0 / (2 * 0.8 * max_accel));
   EXPECT_LT(end.velocity.norm(), 1e-12);
   EXPECT_LT(end.acceleration.norm(), 1e-12);
-  // A second in, a second's deceleration off the speed.
-  const Reference mid = selector.safe_stop(101.0, flown, max_accel);
-  EXPECT_NEAR(mid.velocity.x(), 3.0 - 0.8 * max_accel, 1e-9);
+  // Two seconds in, at full deceleration.
+  const Reference mid = selector.safe_stop(102.0, flown, max_accel);
+  EXPECT_NEAR(mid.velocity.x(), expected.speed_at(2.0), 1e-9);
+  EXPECT_NEAR(mid.acceleration.x(), -0.8 * max_accel, 1e-9);
   // A fresh plan ends the stop; the hand-back ends the avoidance.
   selector.plan_flown();
   EXPECT_FALSE(selector.stopping());
@@ -78,13 +82,19 @@ TEST(ReferenceSelector, AStalePlanIsFollowedByItsStopAndAHover) {
 TEST(ReferenceSelector, TheHoldBeforeAMissionBrakesFromTheVehiclesState) {
   ReferenceSelector selector;
   // Held in trimmed cruise at 3 m/s until the controller engages: the
-  // reference starts on the vehicle, decelerates at 0.4 m/s^2 and hovers.
+  // reference starts on the vehicle, builds up to 0.4 m/s^2 and hovers.
   const Reference first = selector.hold(1.0, Vec3(0, 0, -30), Vec3(3, 0, 0), true);
   EXPECT_LT((first.velocity - Vec3(3, 0, 0)).norm(), 1e-12);
-  EXPECT_NEAR(first.acceleration.norm(), 0.4, 1e-12);
+  EXPECT_LT(first.acceleration.norm(), 1e-12);
+  EXPECT_NEAR(
+      selector.hold(1.0 + kStopOnsetTime, Vec3(99, 0, 0), Vec3::Zero(), false).acceleration.norm(),
+      0.4, 1e-9);
   const Reference later = selector.hold(20.0, Vec3(99, 0, 0), Vec3::Zero(), false);
-  // v^2 / (2 a), and a tau^2 / 24 for the ease-out.
-  EXPECT_NEAR(later.position.x(), 0.5 * 3.0 * 3.0 / 0.4 + 0.4 * kStopRampTime * kStopRampTime / 24,
+  // v^2 / (2 a), half the onset at the speed less a tau^2 / 24 for its
+  // curve, and a tau^2 / 24 for the ease-out.
+  const double onset = kStopOnsetTime, ramp = kStopRampTime;
+  EXPECT_NEAR(later.position.x(),
+              0.5 * 3.0 * 3.0 / 0.4 + 0.5 * 3.0 * onset + 0.4 * (ramp * ramp - onset * onset) / 24,
               1e-9);
   EXPECT_LT(later.velocity.norm(), 1e-12);
 }

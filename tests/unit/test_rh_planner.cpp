@@ -274,7 +274,7 @@ TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
   // 10.2 s: braking from 3.048 m/s at 0.8 of 0.4877 m/s^2 with its 0.8 s
   // ease-out, plus the 2 s kept.
   const auto [window, far] = fail_against_wall_at(55.0);
-  EXPECT_NEAR(window, 3.048 / (0.8 * 0.4877) + 0.5 * kStopRampTime + 2.0, 1e-9);
+  EXPECT_NEAR(window, 3.048 / (0.8 * 0.4877) + 0.5 * (kStopOnsetTime + kStopRampTime) + 2.0, 1e-9);
   EXPECT_EQ(far.mode, StepMode::kKeptPrevious) << far.reason;
   EXPECT_DOUBLE_EQ(far.start_time, 0.0);
   // The same wall 30 m ahead, met 7.6 s on, inside the window: brake now.
@@ -321,22 +321,30 @@ TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
     ASSERT_TRUE(finite(braking));
     EXPECT_LT((braking.position(0) - problem.position).norm(), 1e-9);
     EXPECT_LT((braking.velocity(0) - velocity).norm(), 1e-9);
+    // From the start's acceleration along the velocity, not a step.
+    if (velocity.norm() > 0.1) {
+      EXPECT_NEAR(braking.acceleration(0).dot(velocity.normalized()),
+                  problem.acceleration.dot(velocity.normalized()), 1e-9);
+    }
     const double T = braking.duration();
     EXPECT_LT(braking.velocity(T).norm(), 1e-9);
     EXPECT_LT(braking.velocity(T + 5.0).norm(), 1e-9);
     // Exactly the stop of braking.hpp that the gate checks and the
     // controller flies.
-    const StopProfile stop = stop_from(problem.position, velocity, limit);
+    const StopProfile stop = stop_from(problem.position, velocity, problem.acceleration, limit);
     for (int k = 0; k <= 500; ++k) {
       const double t = T * k / 500.0;
       EXPECT_LE(braking.acceleration(t).norm(), limit + 1e-9) << "t " << t;
       EXPECT_LT((braking.position(t) - stop.position(t)).norm(), 1e-9) << "t " << t;
       EXPECT_LT((braking.velocity(t) - stop.velocity_at(t)).norm(), 1e-9) << "t " << t;
       EXPECT_LT((braking.acceleration(t) - stop.acceleration_at(t)).norm(), 1e-8) << "t " << t;
-      // Decelerating along the velocity: never turning or speeding up.
+      // Along the velocity: never turning; faster only by what the onset
+      // from the speeding-up start adds.
       if (velocity.norm() > 0) {
         EXPECT_GE(braking.velocity(t).dot(velocity), -1e-9);
-        EXPECT_LE(braking.velocity(t).norm(), velocity.norm() + 1e-9);
+        EXPECT_LE(
+            braking.velocity(t).norm(),
+            velocity.norm() + std::max(0.0, stop.start_acceleration) * stop.onset_time + 1e-9);
       }
     }
     EXPECT_LT((braking.position(T) - stop.stop_point()).norm(), 1e-9);

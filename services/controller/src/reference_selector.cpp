@@ -36,7 +36,8 @@ std::optional<std::string> ReferenceSelector::check_start(const Reference& offer
 
 Reference ReferenceSelector::safe_stop(double now, const Reference& flown, double max_accel) {
   if (!stop_) {
-    stop_ = stop_from(flown.position, flown.velocity, settings_.stop_accel_fraction * max_accel);
+    stop_ = stop_from(flown.position, flown.velocity, flown.acceleration,
+                      settings_.stop_accel_fraction * max_accel);
     stop_start_ = now;
   }
   Reference r = along(*stop_, now - stop_start_);

@@ -32,8 +32,9 @@ CommitGate::CommitGate(CommitSettings settings) : settings_(settings) {
 }
 
 StopProfile CommitGate::stop_from_state(const Vec3& position, const Vec3& velocity,
-                                        const Limits& limits) const {
-  return stop_from(position, velocity, settings_.braking_accel_fraction * limits.max_accel);
+                                        const Vec3& acceleration, const Limits& limits) const {
+  return stop_from(position, velocity, acceleration,
+                   settings_.braking_accel_fraction * limits.max_accel);
 }
 
 double CommitGate::unseen_distance(const SeenQuery& seen, const Vec3& point, double radius) const {
@@ -121,7 +122,8 @@ CommitCheck CommitGate::check(const BsplineTrajectory& plan, double elapsed,
   const int instants = std::max(1, static_cast<int>(std::ceil(s.commit_time / s.instant_spacing)));
   for (int k = 0; k <= instants; ++k) {
     const double t = elapsed + s.commit_time * k / instants;
-    const StopProfile stop = stop_from_state(plan.position(t), plan.velocity(t), limits);
+    const StopProfile stop =
+        stop_from_state(plan.position(t), plan.velocity(t), plan.acceleration(t), limits);
     const int points = 1 + static_cast<int>(std::ceil(stop.distance() / s.stop_point_spacing));
     ++out.stops_checked;
     for (int i = 0; i <= points; ++i) {

@@ -87,18 +87,24 @@ double blossom(const Cubic& c, double u1, double u2, double u3) {
          c[3] * u1 * u2 * u3;
 }
 
-/// The distance along a stop as a cubic in t on the phase holding `t`.
+/// d + v u + a u^2 / 2 + j u^3 / 6 with u = t - t0, expanded in t.
+Cubic expanded(double t0, double d, double v, double a, double j) {
+  const double k2 = 0.5 * a, k3 = j / 6.0;
+  return {d - v * t0 + k2 * t0 * t0 - k3 * t0 * t0 * t0, v - 2 * k2 * t0 + 3 * k3 * t0 * t0,
+          k2 - 3 * k3 * t0, k3};
+}
+
+/// The distance along a stop as a cubic in t on the phase holding `t`:
+/// each phase's acceleration is linear in time.
 Cubic stop_piece(const StopProfile& stop, double t) {
-  const double v0 = stop.velocity.norm(), a = stop.peak_deceleration;
-  if (t < stop.constant_time) return {0.0, v0, -0.5 * a, 0.0};
-  if (t < stop.stop_time) {
-    // d1 + v1 u - a u^2 / 2 + a u^3 / (6 tau), u = t - t1, expanded in t.
-    const double t1 = stop.constant_time, tau = stop.ramp_time;
-    const double d1 = stop.distance_at(t1), v1 = v0 - a * t1;
-    const double k2 = -0.5 * a, k3 = a / (6.0 * tau);
-    return {d1 - v1 * t1 + k2 * t1 * t1 - k3 * t1 * t1 * t1, v1 - 2 * k2 * t1 + 3 * k3 * t1 * t1,
-            k2 - 3 * k3 * t1, k3};
-  }
+  const double p = stop.peak_deceleration;
+  const double t1 = stop.onset_time, t2 = t1 + stop.constant_time;
+  if (t < t1)
+    return expanded(0.0, 0.0, stop.velocity.norm(), stop.start_acceleration,
+                    (-p - stop.start_acceleration) / t1);
+  if (t < t2) return expanded(t1, stop.distance_at(t1), stop.speed_at(t1), -p, 0.0);
+  if (t < stop.stop_time)
+    return expanded(t2, stop.distance_at(t2), stop.speed_at(t2), -p, p / stop.ramp_time);
   return {stop.distance(), 0.0, 0.0, 0.0};
 }
 
@@ -106,18 +112,21 @@ Cubic stop_piece(const StopProfile& stop, double t) {
 
 BsplineTrajectory RhPlanner::braking_trajectory(const RhProblem& problem) const {
   // The stop of braking.hpp (the one the commit gate checks and the
-  // controller flies) as a cubic B-spline, exactly: its pieces (constant
-  // deceleration, ease-out, hover) are cubics joined with continuous
+  // controller flies) as a cubic B-spline, exactly: its pieces (onset,
+  // constant deceleration, ease-out, hover) are cubics joined with continuous
   // acceleration, so a knot at each join holds them all.
   const Vec3 position = problem.position.allFinite() ? problem.position : Vec3::Zero();
   const Vec3 velocity = problem.velocity.allFinite() ? problem.velocity : Vec3::Zero();
-  const StopProfile stop = stop_from(position, velocity, braking_decel(problem));
+  const Vec3 acceleration =
+      problem.acceleration.allFinite() ? problem.acceleration : Vec3(Vec3::Zero());
+  const StopProfile stop = stop_from(position, velocity, acceleration, braking_decel(problem));
   const double hold = std::max(kMinHold, stop.stop_time);
   const double duration = stop.stop_time + hold;
   std::vector<double> knots(4, 0.0);  // s, then normalised
-  // A constant part too short to matter gets no knot (the ease-out's cubic
-  // stands in for it, off by far less than a millimetre).
-  if (stop.constant_time > 1e-6 * duration) knots.push_back(stop.constant_time);
+  // An onset or constant part too short to matter gets no knot (the next
+  // phase's cubic stands in for it, off by far less than a millimetre).
+  if (stop.onset_time > 1e-6 * duration) knots.push_back(stop.onset_time);
+  if (stop.constant_time > 1e-6 * duration) knots.push_back(stop.onset_time + stop.constant_time);
   // A hover needs no deceleration piece; any interior knot gives the same
   // constant trajectory.
   knots.push_back(stop.stop_time > 0 ? stop.stop_time : 0.5 * duration);

@@ -47,8 +47,8 @@ struct YawSweep {
 
 /// What the sweep keeps in view (YawSweep::cover_clearance): `clearance` m
 /// to either side of the path at the stopping distance from the vehicle's
-/// speed at `deceleration` m/s^2 (the stop of braking.hpp). A zero or
-/// non-finite entry: no such rule.
+/// speed at `deceleration` m/s^2 (the stop of braking.hpp without its
+/// onset). A zero or non-finite entry: no such rule.
 struct SweepCoverage {
   double clearance = 0;     // m
   double deceleration = 0;  // m/s^2

@@ -98,9 +98,10 @@ class CommitGate {
   CommitCheck check(const BsplineTrajectory& plan, double elapsed, const FlownState& flown,
                     const Limits& limits, const SafetyMap& map) const;
 
-  /// The stop from a state at this gate's deceleration.
+  /// The stop from a state (the acceleration sets the stop's onset) at this
+  /// gate's deceleration.
   StopProfile stop_from_state(const Vec3& position, const Vec3& velocity,
-                              const Limits& limits) const;
+                              const Vec3& acceleration, const Limits& limits) const;
   /// Distance (m) from (north, east) to the nearest cell not seen, searched
   /// out to `radius`; `radius` itself when every cell within it is seen.
   double unseen_distance(const SeenQuery& seen, const Vec3& point, double radius) const;
