@@ -73,7 +73,15 @@ void HttpServer::bind(const std::string& address, int port) {
 }
 
 void HttpServer::start() {
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  thread_ = std::thread([this] {
+    server_->listen_after_bind();
+    listen_ended_ = true;
+  });
+  // stop() only ends a server that is already listening: wait until it is,
+  // so that a stop right after the start (an error on the way up) is not
+  // lost and the join does not hang.
+  while (!server_->is_running() && !listen_ended_)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
 void HttpServer::stop() {

@@ -3,6 +3,7 @@
 // web root, the newest snapshot as JSON, and a Server-Sent Events stream of
 // snapshots. Runs its own threads; the bus thread only touches the hub.
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <thread>
@@ -38,6 +39,7 @@ class HttpServer {
   SnapshotHub& hub_;
   std::unique_ptr<httplib::Server> server_;
   std::thread thread_;
+  std::atomic<bool> listen_ended_{false};
   int port_ = -1;
 };
 
