@@ -142,6 +142,26 @@ class ReplayUsageTest(ScratchTestCase):
         self.assertNotRegex(result.stderr, r"install lcm\b")
 
 
+class WatchUsageTest(ScratchTestCase):
+    WATCH = os.path.join(DEPLOY, "watch.sh")
+
+    def test_help(self):
+        result = run([self.WATCH, "--help"])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue(result.stdout.startswith("usage: deploy/watch.sh"), result.stdout)
+        port = next((l for l in result.stdout.splitlines() if l.strip().startswith("--port N")), "")
+        self.assertIn("(default: 8765)", port)
+
+    def test_usage_errors(self):
+        for args, fragment in (([], "missing COMMAND"),
+                               (["--port"], "--port needs a value"),
+                               (["--log"], "--log needs a value"),
+                               (["--port", "0", "true"], "--port must be a port number"),
+                               (["--port", "http", "true"], "--port must be a port number"),
+                               (["--frobnicate", "true"], "unknown option '--frobnicate'")):
+            self.assert_one_line_error(run([self.WATCH] + args), 2, "watch.sh: error: ", fragment)
+
+
 class SpyAndNetnsUsageTest(ScratchTestCase):
     def test_spy(self):
         spy = os.path.join(DEPLOY, "spy.sh")
@@ -386,7 +406,7 @@ class HelpExamplesTest(unittest.TestCase):
     def test_files_named_in_help_texts_exist(self):
         commands = [[sys.executable, os.path.join(DEPLOY, "launch.py"), "--help"]]
         commands += [[os.path.join(DEPLOY, s), "--help"]
-                     for s in ("fly.sh", "replay.sh", "spy.sh", "netns.sh")]
+                     for s in ("fly.sh", "replay.sh", "spy.sh", "netns.sh", "watch.sh")]
         commands += [[sys.executable, os.path.join(BENCH, s), "--help"] for s in BENCH_SCRIPTS]
         for cmd in commands:
             result = run(cmd)
