@@ -128,6 +128,19 @@ TEST(ViewState, SnapshotCarriesVehicleStatusPlanAndStop) {
   EXPECT_NEAR(stop["point"][1].get<double>(), 0.0, 1e-9);
 }
 
+TEST(ViewState, BytesThatAreNotUtf8BecomeReplacementCharacters) {
+  ViewState view;
+  solver_stats_t solver{};
+  solver.utime = 0;
+  solver.status = solver_stats_t::SOLVED;
+  solver.message = "ok \xff\xfe end";
+  ASSERT_EQ(view.on_solver_stats(solver), "");
+  EXPECT_THROW(view.snapshot().dump(), nlohmann::json::type_error);
+  const auto text = ViewState::to_text(view.snapshot());
+  const auto parsed = nlohmann::json::parse(text);
+  EXPECT_EQ(parsed["solver"]["message"], "ok \xef\xbf\xbd\xef\xbf\xbd end");
+}
+
 TEST(ViewState, NoSafeStopWithoutTheAccelerationLimit) {
   ViewState view;
   view.on_nav_state(nav(1.0, 0.0));

@@ -291,6 +291,10 @@ json ViewState::safe_stop_json() const {
               {"time", stop.stop_time}};
 }
 
+std::string ViewState::to_text(const json& snapshot) {
+  return snapshot.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 json ViewState::snapshot() const {
   json s;
   s["display_unit"] = config_.display_unit;

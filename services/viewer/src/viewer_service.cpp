@@ -67,7 +67,7 @@ void ViewerService::publish_snapshot() {
   auto snapshot = view_.snapshot();
   const auto& c = node_.counters();
   snapshot["bus"] = {{"received", c.received}, {"rejected", c.rejected}};
-  hub_.publish(snapshot.dump());
+  hub_.publish(ViewState::to_text(snapshot));
 }
 
 }  // namespace ofn::viewer

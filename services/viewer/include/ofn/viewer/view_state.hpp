@@ -92,6 +92,10 @@ class ViewState {
 
   /// The whole view as JSON (SI units, world NED; see docs/ARCHITECTURE.md).
   nlohmann::json snapshot() const;
+  /// `snapshot` as text. Strings from the bus (the scenario name, the
+  /// solver's message) need not be UTF-8; bad bytes become U+FFFD rather
+  /// than an exception.
+  static std::string to_text(const nlohmann::json& snapshot);
 
   const ViewCounters& counters() const { return counters_; }
   size_t trail_size() const { return trail_.size(); }
