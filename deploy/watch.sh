@@ -113,7 +113,7 @@ if [[ $host_network == 0 && $(id -u) == 0 ]] && command -v nsenter > /dev/null; 
   fi
 fi
 [[ -n $netns_path || $host_network == 1 ]] ||
-  echo "watch: no private network namespace (needs root); the bus is the host's (ttl=0)" >&2
+  echo "watch: no private network namespace to join (needs root and unshare); the bus is the host's (ttl=0)" >&2
 
 url_file=$(mktemp /tmp/ofn_viewer_url.XXXXXX)
 viewer_args=(--port "$port" --url-file "$url_file")
