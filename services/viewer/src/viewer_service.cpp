@@ -62,8 +62,9 @@ void ViewerService::take(const std::string& channel, const std::string& rejectio
 }
 
 void ViewerService::publish_snapshot() {
-  // Rejections the node made before the view state saw the message
-  // (undecodable, failed validate()) are in the node's counters.
+  // The node counts every rejection: those it made before the view state
+  // saw the message (undecodable, failed validate()) and the view's own,
+  // which take() passes on; the view's are also in "counters".
   auto snapshot = view_.snapshot();
   const auto& c = node_.counters();
   snapshot["bus"] = {{"received", c.received}, {"rejected", c.rejected}};

@@ -232,7 +232,8 @@ function readouts(s) {
   setText("ro-route", s.global_path ? s.global_path.status + ", " + s.global_path.points.length + " points" : "-", s.global_path && s.global_path.stale);
   setText("ro-map", s.cuboids.length + " cuboids" + (s.grid ? ", " + s.grid.occupied + " grid cells" : ""));
   setText("ro-trail", s.trail.length + " points, " + fmt(s.trail_length * scale, 0) + " " + u);
-  const rejected = s.counters.rejected_total + (s.bus ? s.bus.rejected : 0);
+  // The node's count includes the view's own (stamp order) rejections.
+  const rejected = s.bus ? s.bus.rejected : s.counters.rejected_total;
   setText("ro-rejected", String(rejected) + (s.counters.last_rejection ? " (last: " + s.counters.last_rejection + ")" : ""));
   document.getElementById("solver-message").textContent = s.solver ? s.solver.message : "";
 }
