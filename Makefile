@@ -56,8 +56,9 @@ run: deps build
 
 # A recorded flight (LOG=path/to/flight.lcm, or LOG=latest) played into the
 # live viewer on a private bus; the page stays up after the log ends (Ctrl-C).
+# RERUN=<scenario of that flight>: the mapper and planners run again on it.
 replay: deps build
-	$(if $(LOG),,$(error LOG=path/to/flight.lcm or LOG=latest: the flight log to replay))deploy/watch.sh --keep --port $(PORT) --log /tmp/ofn_viewer-replay.log -- deploy/replay.sh $(LOG) --speed $(SPEED)
+	$(if $(LOG),,$(error LOG=path/to/flight.lcm or LOG=latest: the flight log to replay))deploy/watch.sh --keep --port $(PORT) --log /tmp/ofn_viewer-replay.log -- deploy/replay.sh $(LOG) --speed $(SPEED)$(if $(RERUN), --rerun $(RERUN))
 
 test: test-deps build
 	cd $(BUILD) && ctest --output-on-failure -j 2 --timeout 600

@@ -125,7 +125,13 @@ class ReplayUsageTest(ScratchTestCase):
                                ([self.dir], "is not a regular file"),
                                ([empty], "is empty"),
                                ([log, "--speed", "0"], "--speed must be a positive number"),
-                               ([log, "--speed", "x2"], "--speed must be a positive number")):
+                               ([log, "--speed", "x2"], "--speed must be a positive number"),
+                               ([log, "--rerun"], "--rerun needs a value"),
+                               ([log, "--rerun", os.path.join(self.dir, "none.yaml")],
+                                "none.yaml' not found"),
+                               ([log, "--rerun", log, "--channels", "NAV_STATE"],
+                                "leave out --channels"),
+                               ([log, "--rerun", log, "--loop"], "leave out --loop")):
             self.assert_one_line_error(run([self.REPLAY] + args), 2, "replay.sh: error: ", fragment)
 
     def test_missing_player_names_the_debian_package(self):
