@@ -139,9 +139,13 @@ if [ -n "$RERUN" ]; then
             "--regexp=^(NAV_STATE|SIM_CLOCK|LIDAR_RAW|MISSION|VIRTUAL_OBSTACLES|CONTROL_STATUS)\$")
     [ "$VERBOSE" -eq 0 ] || PLAYER+=(--verbose)
     PLAYER+=("$LOGFILE")
+    # The launcher in a process group of its own: a Ctrl-C reaches the
+    # player, and this script then stops the services once.
+    set -m
     /usr/bin/python3 "$REPO_ROOT/deploy/launch.py" --scenario "$RERUN" --lcm-url "$LCM_URL" \
         --only sensor_interface,mapper,global_planner,rh_optimizer --no-record --timeout 0 &
     SERVICES=$!
+    set +m
     trap 'kill -INT "$SERVICES" 2> /dev/null; wait "$SERVICES"; exit 130' INT TERM
     # The services follow the replayed SIM_CLOCK; this is the time they get
     # to start and subscribe (what they miss of the start is the first scans).

@@ -81,12 +81,11 @@ cleanup() {
   [[ -z $url_file ]] || rm -f "$url_file"
 }
 trap cleanup EXIT
-# A stop signal goes on to COMMAND, which ends its run cleanly (background
-# commands of a script ignore the terminal's Ctrl-C unless they catch it).
+# A stop signal goes on to COMMAND, which ends its run cleanly.
 stop_signal=""
 on_stop() {
   stop_signal=$1
-  [[ -z $command_pid ]] || kill -"$1" "$command_pid" 2> /dev/null || true
+  [[ -z $command_pid ]] || kill -"$1" -- "-$command_pid" 2> /dev/null || true
   [[ -n $command_pid ]] || exit $((128 + $2))
 }
 trap 'on_stop INT 2' INT
@@ -138,12 +137,18 @@ if [[ -n ${DISPLAY:-}${WAYLAND_DISPLAY:-} ]] && command -v xdg-open > /dev/null;
 fi
 
 status=0
+# COMMAND runs in a process group of its own (job control on), where the
+# terminal's Ctrl-C does not reach it but SIGINT is not ignored either, as
+# it would be for a background command of a script: the one stop signal its
+# group gets is the one forwarded above, which it handles as a Ctrl-C.
+set -m
 if [[ -n $netns_path ]]; then
   nsenter --net="$netns_path" -- "$@" &
 else
   "$@" &
 fi
 command_pid=$!
+set +m
 # A trapped signal interrupts `wait`; wait again until COMMAND has ended.
 while :; do
   status=0
