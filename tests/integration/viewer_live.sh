@@ -4,7 +4,8 @@
 # bus; the snapshot over HTTP shows the vehicle moved along the course with
 # the map, the route and the plans, the event stream carries snapshots, and
 # headless Chromium shows the page with its readouts filled and the trail
-# drawn (a screenshot before the replay has none), the stream live.
+# drawn (a screenshot before the replay has none), the stream live; and
+# deploy/watch.sh's viewer shows a replay in a namespace of its own.
 source "$(dirname "$0")/common.sh"
 command -v chromium > /dev/null || fail "chromium is missing: run 'make test-deps' (the Makefile installs it)"
 /usr/bin/python3 -c "import PIL" 2> /dev/null || fail "Pillow is missing: run 'make test-deps'"
@@ -127,4 +128,42 @@ if after < before + 300:
 if problems:
     sys.exit("; ".join(problems))
 PY
-pass "the viewer showed the replayed flight in the browser"
+
+# deploy/watch.sh: the same log in a namespace of its own, with a viewer
+# that serves here and listens there. Its page shows the vehicle; none of
+# that traffic reaches this namespace's bus (the first viewer's count of
+# navigation messages stays as it was).
+port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+"$REPO/deploy/watch.sh" --port "$port" --bin "$BIN" --log "$WORK/watch_viewer.log" -- \
+  "$REPO/deploy/replay.sh" "$WORK/flight/flight.lcm" --speed 8 > "$WORK/watch.txt" 2>&1 &
+watch=$!
+/usr/bin/python3 - "$url" "http://127.0.0.1:$port/" <<'PY' || { cat "$WORK/watch.txt"; kill $watch; fail "deploy/watch.sh's viewer did not show the flight"; }
+import json, sys, time, urllib.request
+def snapshot(url):
+    with urllib.request.urlopen(url + "api/snapshot", timeout=10) as r:
+        return json.load(r)
+def navs(s):
+    return s["counters"]["accepted"].get("NAV_STATE", 0)
+here_before = navs(snapshot(sys.argv[1]))
+seen = None
+for _ in range(600):
+    try:
+        s = snapshot(sys.argv[2])
+    except OSError:
+        time.sleep(0.1)  # not serving yet
+        continue
+    if s["vehicle"] is not None and s["trail_length"] > 20:
+        seen = s
+        break
+    time.sleep(0.1)
+if seen is None:
+    sys.exit("no vehicle on the watched bus")
+here_after = navs(snapshot(sys.argv[1]))
+print("watched bus: vehicle at north %.1f m, trail %.0f m; this namespace's bus: %d -> %d NAV_STATE"
+      % (seen["vehicle"]["position"][0], seen["trail_length"], here_before, here_after))
+if here_after != here_before:
+    sys.exit("the watched replay reached this namespace's bus")
+PY
+wait $watch || { cat "$WORK/watch.txt"; fail "deploy/watch.sh exited with code $?"; }
+grep -q "no private network namespace" "$WORK/watch.txt" && { cat "$WORK/watch.txt"; fail "watch.sh did not make a namespace"; }
+pass "the viewer showed the replayed flight in the browser, and beside a namespace of its own"
