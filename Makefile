@@ -6,6 +6,8 @@ BUILD    ?= build
 JOBS     ?= $(shell nproc)
 SCENARIO ?= sim/scenarios/bench3.yaml
 RTF      ?= 1.0
+PORT     ?= 8765
+SPEED    ?= 1.0
 PYTHON   := /usr/bin/python3
 
 # Every Debian package the project uses (build, run, test, bench, lcm-spy, plots).
@@ -14,20 +16,31 @@ DEBIAN_PACKAGES := cmake make g++ git liblcm-dev liblcm-bin liblcm-java libjchar
   libdynamicedt3d-dev libspdlog-dev libcli11-dev libyaml-cpp-dev libgtest-dev \
   libbenchmark-dev libompl-dev libboost-serialization-dev libboost-filesystem-dev \
   libboost-system-dev python3 python3-matplotlib python3-numpy python3-yaml iproute2 \
-  util-linux procps
+  util-linux procps libcpp-httplib-dev nlohmann-json3-dev pkg-config
+# Only `make test` needs these: the headless browser that loads the live
+# viewer's page, and Pillow to read its screenshot. `make run` pulls no browser.
+TEST_PACKAGES := chromium python3-pil
 
-.PHONY: all deps build run test bench spy clean format
+.PHONY: all deps test-deps build run replay test bench spy clean format
 
 all: build
 
-deps:
-	@missing=""; for p in $(DEBIAN_PACKAGES); do \
+# install_missing PACKAGES: apt-get installs those not installed yet.
+define install_missing
+	@missing=""; for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "ok installed" || missing="$$missing $$p"; \
 	done; \
 	if [ -z "$$missing" ]; then echo "deps: all Debian packages present"; exit 0; fi; \
 	echo "deps: installing$$missing"; \
 	sudo=""; [ "$$(id -u)" = 0 ] || sudo=sudo; \
 	$$sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -qq $$missing
+endef
+
+deps:
+	$(call install_missing,$(DEBIAN_PACKAGES))
+
+test-deps:
+	$(call install_missing,$(DEBIAN_PACKAGES) $(TEST_PACKAGES))
 
 $(BUILD)/CMakeCache.txt:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo
@@ -37,10 +50,17 @@ build: $(BUILD)/CMakeCache.txt
 
 # The main job: the benchmark course flown by all services as separate processes.
 # HOSTS=3: on the gcs/onboard1/onboard2 split, three network namespaces on a bridge.
+# WATCH=1: the flight live in a browser (deploy/watch.sh); the URL is printed.
 run: deps build
-	$(if $(filter-out 1 3,$(HOSTS)),$(error HOSTS=$(HOSTS): use HOSTS=3 for three hosts or leave it unset for one))deploy/$(if $(filter 3,$(HOSTS)),fly_three_hosts.sh,fly.sh) --scenario $(SCENARIO) --rtf $(RTF)
+	$(if $(filter-out 1 3,$(HOSTS)),$(error HOSTS=$(HOSTS): use HOSTS=3 for three hosts or leave it unset for one))$(if $(and $(filter 1,$(WATCH)),$(filter 3,$(HOSTS))),$(error WATCH=1 watches the one-host flight: leave HOSTS unset))deploy/$(if $(filter 3,$(HOSTS)),fly_three_hosts.sh,fly.sh) --scenario $(SCENARIO) --rtf $(RTF)$(if $(filter 1,$(WATCH)), --watch --port $(PORT))
 
-test: deps build
+# A recorded flight (LOG=path/to/flight.lcm, or LOG=latest) played into the
+# live viewer on a private bus; the page stays up after the log ends (Ctrl-C).
+# RERUN=<scenario of that flight>: the mapper and planners run again on it.
+replay: deps build
+	$(if $(LOG),,$(error LOG=path/to/flight.lcm or LOG=latest: the flight log to replay))deploy/watch.sh --keep --port $(PORT) --log /tmp/ofn_viewer-replay.log -- deploy/replay.sh $(LOG) --speed $(SPEED)$(if $(RERUN), --rerun $(RERUN))
+
+test: test-deps build
 	cd $(BUILD) && ctest --output-on-failure -j 2 --timeout 600
 
 bench: deps build

@@ -44,3 +44,15 @@ find_package(NLopt QUIET CONFIG)
 ofn_require(NLopt_FOUND "NLopt" libnlopt-dev)
 find_file(NLOPT_CXX_HEADER nlopt.hpp)
 ofn_require(NLOPT_CXX_HEADER "NLopt C++ header" libnlopt-cxx-dev)
+
+# The live viewer: JSON snapshots (nlohmann-json) served over HTTP
+# (cpp-httplib; Debian ships it as a library with a pkg-config file).
+find_package(nlohmann_json 3 QUIET)
+ofn_require(nlohmann_json_FOUND "nlohmann-json" nlohmann-json3-dev)
+find_package(PkgConfig QUIET)
+if(PkgConfig_FOUND)
+  pkg_check_modules(HTTPLIB QUIET IMPORTED_TARGET cpp-httplib)
+endif()
+ofn_require(HTTPLIB_FOUND "cpp-httplib" libcpp-httplib-dev)
+add_library(ofn::httplib INTERFACE IMPORTED)
+set_target_properties(ofn::httplib PROPERTIES INTERFACE_LINK_LIBRARIES PkgConfig::HTTPLIB)

@@ -13,10 +13,13 @@ rtf=1.0
 timeout=300
 out=""
 netns=1
+watch=0
+port=8765
 
 usage() {
   cat <<EOF
 usage: deploy/fly.sh [--scenario FILE] [--rtf X] [--out DIR] [--timeout S] [--host-network]
+                     [--watch] [--port N]
 
 Flies a scenario through the real service processes (deploy/launch.py) on
 LCM multicast, records the bus, and writes the flight report: a CSV per
@@ -28,6 +31,10 @@ channel, summary.json, summary.txt and the figures flight.png, tracking.png.
   --timeout S       wall-clock run limit in seconds (default: 300)
   --host-network    run on the host network instead of a private network
                     namespace (default: a namespace when one can be made)
+  --watch           watch the flight live in a browser: the viewer
+                    (deploy/watch.sh) joins the flight's bus and serves the
+                    page on 127.0.0.1; its URL is printed (default: off)
+  --port N          the page's HTTP port with --watch (default: 8765)
   -h, --help        show this help
 
 The flight's LCM log is named in DIR/latest_log; replay the most recent
@@ -46,11 +53,19 @@ EOF
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --host-network) netns=0; shift ;;
+    --watch) watch=1; shift ;;
+    --port) need_value "$1" $#; port=$2; shift 2 ;;
+    --port=*) port=${1#*=}; shift ;;
     -h|--help) usage; exit 0 ;;
     *) flight_option "$@"; shift "$taken" ;;
   esac
 done
 check_flight_options "$scenario" "$rtf" "$timeout" "$repo/build/bin"
+if [[ $watch == 1 ]]; then
+  [[ $port =~ ^[0-9]+$ ]] && ((port >= 1 && port <= 65535)) ||
+    die_usage "--port must be a port number 1-65535, got '$port'"
+  [[ -x "$repo/build/bin/ofn_viewer" ]] || die_usage "--watch needs ofn_viewer: run 'make build'"
+fi
 [[ -n "$out" ]] || out="$repo/results/run-$(date +%Y%m%d-%H%M%S)"
 mkdir -p "$out"
 
@@ -58,7 +73,11 @@ launch=(/usr/bin/python3 "$repo/deploy/launch.py" --scenario "$scenario" --rtf "
         --log-dir "$out" --timeout "$timeout")
 echo "fly: scenario $scenario, real-time factor $rtf, results in $out"
 status=0
-if [[ $netns == 1 ]]; then
+if [[ $watch == 1 ]]; then
+  watch_args=(--port "$port" --log "$out/viewer.log")
+  [[ $netns == 1 ]] || watch_args+=(--host-network)
+  "$repo/deploy/watch.sh" "${watch_args[@]}" -- "${launch[@]}" || status=$?
+elif [[ $netns == 1 ]]; then
   "$repo/deploy/netns.sh" --fallback "${launch[@]}" || status=$?
 else
   "${launch[@]}" || status=$?

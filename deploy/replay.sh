@@ -13,11 +13,12 @@ LOOP=0
 CHANNELS=""
 VERBOSE=0
 LOGFILE=""
+RERUN=""
 
 usage() {
     cat <<EOF
 usage: deploy/replay.sh LOGFILE [--speed X] [--lcm-url URL] [--loop]
-                        [--channels REGEX] [--verbose]
+                        [--channels REGEX] [--rerun SCENARIO] [--verbose]
 
 Publishes the messages of a recorded flight on LCM with their original timing.
 
@@ -33,6 +34,13 @@ Publishes the messages of a recorded flight on LCM with their original timing.
                     (default: play it once)
   --channels REGEX  replay only channels matching this GLib regular expression
                     (default: all channels)
+  --rerun SCENARIO  run sensor_interface, mapper, global_planner and
+                    rh_optimizer again on the recording (deploy/launch.py
+                    --only ..., with SCENARIO, the scenario of that flight)
+                    and replay only their inputs and what a watcher needs
+                    (NAV_STATE, SIM_CLOCK, LIDAR_RAW, MISSION,
+                    VIRTUAL_OBSTACLES, CONTROL_STATUS): the map, route and
+                    plans on the bus are then theirs (default: no services)
   -v, --verbose     print every replayed message
   -h, --help        show this help
 
@@ -73,6 +81,8 @@ while [ $# -gt 0 ]; do
         --lcm-url=*)  LCM_URL="${1#*=}"; shift ;;
         --channels)   need_value "$1" $#; CHANNELS="$2"; shift 2 ;;
         --channels=*) CHANNELS="${1#*=}"; shift ;;
+        --rerun)      need_value "$1" $#; RERUN="$2"; shift 2 ;;
+        --rerun=*)    RERUN="${1#*=}"; shift ;;
         --loop)       LOOP=1; shift ;;
         --verbose|-v) VERBOSE=1; shift ;;
         -h|--help)    usage; exit 0 ;;
@@ -84,6 +94,11 @@ while [ $# -gt 0 ]; do
 done
 
 [ -n "$LOGFILE" ] || die_usage "missing LOGFILE"
+if [ -n "$RERUN" ]; then
+    [ -z "$CHANNELS" ] || die_usage "--rerun chooses the channels itself; leave out --channels"
+    [ "$LOOP" -eq 0 ] || die_usage "--rerun plays the log once; leave out --loop"
+    [ -f "$RERUN" ] || die_usage "scenario '$RERUN' not found"
+fi
 
 if [ "$LOGFILE" = latest ]; then
     # deploy/launch.py writes <log dir>/latest_log, results/latest_log by
@@ -116,6 +131,33 @@ PLAYER=(lcm-logplayer "--speed=$SPEED" "--lcm-url=$LCM_URL")
 [ -z "$CHANNELS" ] || PLAYER+=("--regexp=$CHANNELS")
 [ "$VERBOSE" -eq 0 ] || PLAYER+=(--verbose)
 PLAYER+=("$LOGFILE")
+
+if [ -n "$RERUN" ]; then
+    # The planners' inputs, and what a watcher (the live viewer) draws
+    # besides their outputs; the recorded outputs stay out.
+    PLAYER=(lcm-logplayer "--speed=$SPEED" "--lcm-url=$LCM_URL"
+            "--regexp=^(NAV_STATE|SIM_CLOCK|LIDAR_RAW|MISSION|VIRTUAL_OBSTACLES|CONTROL_STATUS)\$")
+    [ "$VERBOSE" -eq 0 ] || PLAYER+=(--verbose)
+    PLAYER+=("$LOGFILE")
+    # The launcher in a process group of its own: a Ctrl-C reaches the
+    # player, and this script then stops the services once.
+    set -m
+    /usr/bin/python3 "$REPO_ROOT/deploy/launch.py" --scenario "$RERUN" --lcm-url "$LCM_URL" \
+        --only sensor_interface,mapper,global_planner,rh_optimizer --no-record --timeout 0 &
+    SERVICES=$!
+    set +m
+    trap 'kill -INT "$SERVICES" 2> /dev/null; wait "$SERVICES"; exit 130' INT TERM
+    # The services follow the replayed SIM_CLOCK; this is the time they get
+    # to start and subscribe (what they miss of the start is the first scans).
+    sleep 2
+    kill -0 "$SERVICES" 2> /dev/null || die "the services did not start (see the launcher's message above)"
+    echo "replay.sh: replaying the inputs of $LOGFILE at ${SPEED}x on $LCM_URL into sensor_interface, mapper, global_planner, rh_optimizer"
+    status=0
+    "${PLAYER[@]}" || status=$?
+    kill -INT "$SERVICES" 2> /dev/null || true
+    wait "$SERVICES" || true
+    exit "$status"
+fi
 
 echo "replay.sh: replaying $LOGFILE at ${SPEED}x on $LCM_URL${CHANNELS:+ (channels /$CHANNELS/)}"
 if [ "$LOOP" -eq 0 ]; then

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Random bytes, NaN-filled messages and well-formed forgeries (a clock jump,
 # a DONE, a plan at five times the speed limit, a cyclic beyond its range)
-# on every channel during a flight: nothing crashes, the rejection counters
+# on every channel during a flight: nothing crashes (the live viewer
+# included, which still serves its page afterwards), the rejection counters
 # rise, the run is not ended by the forged DONE, the controller never flies
 # a reference faster than the limit, and the flight completes.
 source "$(dirname "$0")/common.sh"
@@ -9,9 +10,24 @@ source "$(dirname "$0")/common.sh"
   --bin "$BIN" --rtf 4 --log-dir "$WORK/run" --timeout 150 --no-pin --max-restarts 0 \
   > "$WORK/launch.txt" 2>&1 &
 launcher=$!
+# The live viewer listens to the same flood.
+"$BIN/ofn_viewer" --port 0 --url-file "$WORK/viewer_url" > "$WORK/viewer.txt" 2>&1 &
+viewer=$!
 sleep 3
-"$BIN/ofn_bus_fuzz" --expect vehicle_sim --expect controller --expect flight_monitor ||
-  { kill -INT $launcher; wait $launcher || true; fail "a service died or rejected nothing"; }
+"$BIN/ofn_bus_fuzz" --expect vehicle_sim --expect controller --expect flight_monitor \
+  --expect viewer ||
+  { kill -INT $launcher; wait $launcher || true; kill $viewer; fail "a service died or rejected nothing"; }
+# After the flood the viewer still serves the flight it watches.
+/usr/bin/python3 - "$(cat "$WORK/viewer_url")" <<'PY' ||
+import json, sys, urllib.request
+s = json.load(urllib.request.urlopen(sys.argv[1] + "api/snapshot", timeout=10))
+print("viewer: %d rejected, %d of them by the view's stamp order; vehicle at north %.1f m"
+      % (s["bus"]["rejected"], s["counters"]["rejected_total"], s["vehicle"]["position"][0]))
+sys.exit(0 if s["bus"]["rejected"] > 0 and s["vehicle"] is not None else 1)
+PY
+  { kill -INT $launcher; wait $launcher || true; kill $viewer; fail "the viewer stopped serving or rejected nothing"; }
+kill -INT $viewer
+wait $viewer || fail "the viewer did not stop cleanly after the flood"
 wait $launcher || { tail -40 "$WORK/launch.txt"; fail "launcher exit code $? after the flood"; }
 if grep -qi "restarting" "$WORK/launch.txt"; then fail "a service had to be restarted"; fi
 log=$(cat "$WORK/run/latest_log")

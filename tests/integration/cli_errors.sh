@@ -32,4 +32,11 @@ expect_error "File does not exist" "$BIN/ofn_controller" --config "$WORK/missing
 printf 'not: [valid' > "$WORK/broken.yaml"
 expect_error "broken.yaml: line" "$BIN/ofn_sim_runner" --scenario "$WORK/broken.yaml"
 expect_error "no NAV_STATE\|cannot read" "$BIN/ofn_flight_report" --log "$WORK/ctl.yaml" --out "$WORK/r"
+# The viewer: one line for a usage error, the same exit code 2.
+expect_error "^ofn_viewer: error: .*--port" "$BIN/ofn_viewer" --port 70000
+[[ $(wc -l < "$WORK/out.txt") -eq 1 ]] || { cat "$WORK/out.txt"; fail "ofn_viewer's usage error is not one line"; }
+expect_error "holds no index.html" "$BIN/ofn_viewer" --web-root "$WORK"
+expect_error "lcm-netns: cannot open '$WORK/no-such-ns'" "$BIN/ofn_viewer" --port 0 --lcm-netns "$WORK/no-such-ns"
+[[ $("$BIN/ofn_viewer" --version) =~ ^ofn_viewer\ [0-9]+\.[0-9]+\.[0-9]+$ ]] || fail "ofn_viewer --version"
+"$BIN/ofn_viewer" --help | grep -q -- "--port.*8765" || fail "ofn_viewer --help does not show the port's default"
 pass "bad command lines and files rejected with clear messages"

@@ -125,7 +125,13 @@ class ReplayUsageTest(ScratchTestCase):
                                ([self.dir], "is not a regular file"),
                                ([empty], "is empty"),
                                ([log, "--speed", "0"], "--speed must be a positive number"),
-                               ([log, "--speed", "x2"], "--speed must be a positive number")):
+                               ([log, "--speed", "x2"], "--speed must be a positive number"),
+                               ([log, "--rerun"], "--rerun needs a value"),
+                               ([log, "--rerun", os.path.join(self.dir, "none.yaml")],
+                                "none.yaml' not found"),
+                               ([log, "--rerun", log, "--channels", "NAV_STATE"],
+                                "leave out --channels"),
+                               ([log, "--rerun", log, "--loop"], "leave out --loop")):
             self.assert_one_line_error(run([self.REPLAY] + args), 2, "replay.sh: error: ", fragment)
 
     def test_missing_player_names_the_debian_package(self):
@@ -140,6 +146,26 @@ class ReplayUsageTest(ScratchTestCase):
         result = run(["/bin/bash", self.REPLAY, log], env=dict(os.environ, PATH=tools))
         self.assert_one_line_error(result, 1, "lcm-logplayer not found", "apt-get install liblcm-bin")
         self.assertNotRegex(result.stderr, r"install lcm\b")
+
+
+class WatchUsageTest(ScratchTestCase):
+    WATCH = os.path.join(DEPLOY, "watch.sh")
+
+    def test_help(self):
+        result = run([self.WATCH, "--help"])
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue(result.stdout.startswith("usage: deploy/watch.sh"), result.stdout)
+        port = next((l for l in result.stdout.splitlines() if l.strip().startswith("--port N")), "")
+        self.assertIn("(default: 8765)", port)
+
+    def test_usage_errors(self):
+        for args, fragment in (([], "missing COMMAND"),
+                               (["--port"], "--port needs a value"),
+                               (["--log"], "--log needs a value"),
+                               (["--port", "0", "true"], "--port must be a port number"),
+                               (["--port", "http", "true"], "--port must be a port number"),
+                               (["--frobnicate", "true"], "unknown option '--frobnicate'")):
+            self.assert_one_line_error(run([self.WATCH] + args), 2, "watch.sh: error: ", fragment)
 
 
 class SpyAndNetnsUsageTest(ScratchTestCase):
@@ -386,7 +412,7 @@ class HelpExamplesTest(unittest.TestCase):
     def test_files_named_in_help_texts_exist(self):
         commands = [[sys.executable, os.path.join(DEPLOY, "launch.py"), "--help"]]
         commands += [[os.path.join(DEPLOY, s), "--help"]
-                     for s in ("fly.sh", "replay.sh", "spy.sh", "netns.sh")]
+                     for s in ("fly.sh", "replay.sh", "spy.sh", "netns.sh", "watch.sh")]
         commands += [[sys.executable, os.path.join(BENCH, s), "--help"] for s in BENCH_SCRIPTS]
         for cmd in commands:
             result = run(cmd)
