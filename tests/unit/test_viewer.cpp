@@ -8,6 +8,7 @@
 #include <limits>
 #include <thread>
 
+#include "ofn/common/braking.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/viewer/snapshot_hub.hpp"
 #include "ofn/viewer/view_state.hpp"
@@ -124,6 +125,9 @@ TEST(ViewState, SnapshotCarriesVehicleStatusPlanAndStop) {
   ASSERT_FALSE(stop.is_null());
   EXPECT_NEAR(stop["start"][0].get<double>(), 11.0, 1e-9);
   EXPECT_GT(stop["distance"].get<double>(), 2.5);
+  // The stop of braking.hpp that the controller would fly from there.
+  EXPECT_NEAR(stop["distance"].get<double>(),
+              stop_from(Vec3::Zero(), Vec3(2.0, 0, 0), Vec3::Zero(), 0.8).distance(), 1e-9);
   EXPECT_NEAR(stop["point"][0].get<double>(), 11.0 + stop["distance"].get<double>(), 1e-9);
   EXPECT_NEAR(stop["point"][1].get<double>(), 0.0, 1e-9);
 }

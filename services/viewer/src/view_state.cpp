@@ -30,25 +30,25 @@ json points(const std::vector<std::vector<double>>& rows) {
 
 // The plan's position and velocity `t` s after its t0 (linear between
 // samples, held at the ends).
-void sample_plan(const ref_traj_t& plan, double t, Vec3& position, Vec3& velocity) {
+/// The plan's state at `t` s after its t0, linear between its samples.
+struct PlanState {
+  Vec3 position, velocity, acceleration;
+};
+PlanState sample_plan(const ref_traj_t& plan, double t) {
   const auto& ts = plan.sample_time;
-  auto at = [&](const std::vector<std::vector<double>>& rows, size_t i) {
-    return Vec3(rows[i][0], rows[i][1], rows[i][2]);
+  auto state = [&](size_t i) {
+    auto at = [i](const std::vector<std::vector<double>>& rows) {
+      return Vec3(rows[i][0], rows[i][1], rows[i][2]);
+    };
+    return PlanState{at(plan.position), at(plan.velocity), at(plan.acceleration)};
   };
-  if (t <= ts.front()) {
-    position = at(plan.position, 0);
-    velocity = at(plan.velocity, 0);
-    return;
-  }
-  if (t >= ts.back()) {
-    position = at(plan.position, ts.size() - 1);
-    velocity = at(plan.velocity, ts.size() - 1);
-    return;
-  }
+  if (t <= ts.front()) return state(0);
+  if (t >= ts.back()) return state(ts.size() - 1);
   const size_t i = static_cast<size_t>(std::upper_bound(ts.begin(), ts.end(), t) - ts.begin());
   const double w = (t - ts[i - 1]) / (ts[i] - ts[i - 1]);
-  position = (1 - w) * at(plan.position, i - 1) + w * at(plan.position, i);
-  velocity = (1 - w) * at(plan.velocity, i - 1) + w * at(plan.velocity, i);
+  const PlanState a = state(i - 1), b = state(i);
+  return {(1 - w) * a.position + w * b.position, (1 - w) * a.velocity + w * b.velocity,
+          (1 - w) * a.acceleration + w * b.acceleration};
 }
 
 }  // namespace
@@ -281,11 +281,10 @@ json ViewState::safe_stop_json() const {
   // committed instant"). Needs the limit from MISSION.
   if (!ref_traj_ || !mission_) return nullptr;
   const double t = to_seconds(ref_traj_->utime - ref_traj_->t0_utime) + config_.ref_traj_timeout;
-  Vec3 position, velocity;
-  sample_plan(*ref_traj_, t, position, velocity);
-  const auto stop =
-      stop_from(position, velocity, config_.stop_accel_fraction * mission_->limits.max_accel);
-  return json{{"start", vec(position)},
+  const PlanState at = sample_plan(*ref_traj_, t);
+  const auto stop = stop_from(at.position, at.velocity, at.acceleration,
+                              config_.stop_accel_fraction * mission_->limits.max_accel);
+  return json{{"start", vec(at.position)},
               {"point", vec(stop.stop_point())},
               {"distance", stop.distance()},
               {"time", stop.stop_time}};
