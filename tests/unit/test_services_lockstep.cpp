@@ -120,11 +120,12 @@ TEST_F(LockstepServices, YawSweepsTheScannerOnlyWhileScansArrive) {
   const FlightResult scanning = fly_open_course(scenario, true);
   ASSERT_TRUE(scanning.arrived);
   // Faded in over the first period. At cruise the sweep reaches R_s beside
-  // the path at the stopping distance (0.8 of the acceleration limit): for
-  // the open course's limits wider than the nominal 40 deg peak to peak.
-  const double stopping =
-      stop_from(Vec3::Zero(), Vec3(scenario.cruise_speed, 0, 0), 0.8 * scenario.limits.max_accel)
-          .distance();
+  // the path at the stopping distance (0.8 of the acceleration limit, the
+  // stop without its onset): for the open course's limits wider than the
+  // nominal 40 deg peak to peak.
+  const double stopping = stop_from(Vec3::Zero(), Vec3(scenario.cruise_speed, 0, 0),
+                                    0.8 * scenario.limits.max_accel, kStopRampTime, 0.0)
+                              .distance();
   const double span = 2.0 * std::atan2(scenario.limits.clearance, stopping);
   ASSERT_GT(rad2deg(span), 41.0);
   EXPECT_NEAR(yaw_span(scanning, 10.0, 20.0), span, deg2rad(1.0));
