@@ -100,8 +100,8 @@ class CommitGate {
 
   /// The stop from a state (the acceleration sets the stop's onset) at this
   /// gate's deceleration.
-  StopProfile stop_from_state(const Vec3& position, const Vec3& velocity,
-                              const Vec3& acceleration, const Limits& limits) const;
+  StopProfile stop_from_state(const Vec3& position, const Vec3& velocity, const Vec3& acceleration,
+                              const Limits& limits) const;
   /// Distance (m) from (north, east) to the nearest cell not seen, searched
   /// out to `radius`; `radius` itself when every cell within it is seen.
   double unseen_distance(const SeenQuery& seen, const Vec3& point, double radius) const;
