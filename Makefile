@@ -21,7 +21,7 @@ DEBIAN_PACKAGES := cmake make g++ git liblcm-dev liblcm-bin liblcm-java libjchar
 # viewer's page, and Pillow to read its screenshot. `make run` pulls no browser.
 TEST_PACKAGES := chromium python3-pil
 
-.PHONY: all deps test-deps build run replay test bench spy clean format
+.PHONY: all deps test-deps build flight run replay test bench spy clean format
 
 all: build
 
@@ -48,16 +48,27 @@ $(BUILD)/CMakeCache.txt:
 build: $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
+# What a flight, its report and a replay run: the services, the flight
+# monitor and report, the live viewer and its page. `make run` and `make
+# replay` build only these (the tests and benchmarks are most of a full
+# build); `make test` builds everything.
+FLIGHT_TARGETS := ofn_vehicle_sim ofn_controller ofn_mission_uplink ofn_flight_monitor \
+  ofn_obstacle_injector ofn_sensor_interface ofn_mapper ofn_global_planner ofn_rh_optimizer \
+  ofn_flight_report ofn_viewer ofn_viewer_web
+
+flight: $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target $(FLIGHT_TARGETS)
+
 # The main job: the benchmark course flown by all services as separate processes.
 # HOSTS=3: on the gcs/onboard1/onboard2 split, three network namespaces on a bridge.
 # WATCH=1: the flight live in a browser (deploy/watch.sh); the URL is printed.
-run: deps build
+run: deps flight
 	$(if $(filter-out 1 3,$(HOSTS)),$(error HOSTS=$(HOSTS): use HOSTS=3 for three hosts or leave it unset for one))$(if $(and $(filter 1,$(WATCH)),$(filter 3,$(HOSTS))),$(error WATCH=1 watches the one-host flight: leave HOSTS unset))deploy/$(if $(filter 3,$(HOSTS)),fly_three_hosts.sh,fly.sh) --scenario $(SCENARIO) --rtf $(RTF)$(if $(filter 1,$(WATCH)), --watch --port $(PORT))
 
 # A recorded flight (LOG=path/to/flight.lcm, or LOG=latest) played into the
 # live viewer on a private bus; the page stays up after the log ends (Ctrl-C).
 # RERUN=<scenario of that flight>: the mapper and planners run again on it.
-replay: deps build
+replay: deps flight
 	$(if $(LOG),,$(error LOG=path/to/flight.lcm or LOG=latest: the flight log to replay))deploy/watch.sh --keep --port $(PORT) --log /tmp/ofn_viewer-replay.log -- deploy/replay.sh $(LOG) --speed $(SPEED)$(if $(RERUN), --rerun $(RERUN))
 
 test: test-deps build
