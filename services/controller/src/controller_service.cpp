@@ -5,6 +5,7 @@
 #include "ofn/actuator_cmd_t.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/mission_plan.hpp"
+#include "ofn/common/ref_traj_sample.hpp"
 #include "ofn/control_status_t.hpp"
 
 namespace ofn::control {
@@ -154,19 +155,12 @@ ControllerConfig load_controller_config(YamlReader& r) {
 }
 
 std::optional<Reference> sample_ref_traj(const ref_traj_t& traj, Utime now) {
-  const double t = to_seconds(now - traj.t0_utime);
-  const auto& ts = traj.sample_time;
-  if (ts.size() < 2 || t < ts.front() || t > ts.back()) return std::nullopt;
-  const size_t i =
-      std::min<size_t>(ts.size() - 2, std::upper_bound(ts.begin(), ts.end(), t) - ts.begin() - 1);
-  const double f = (t - ts[i]) / (ts[i + 1] - ts[i]);
-  auto lerp = [&](const std::vector<std::vector<double>>& v) -> Vec3 {
-    return (1.0 - f) * vec(v[i]) + f * vec(v[i + 1]);
-  };
+  const auto sample = sample_ref_traj_at(traj, to_seconds(now - traj.t0_utime));
+  if (!sample) return std::nullopt;
   Reference r;
-  r.position = lerp(traj.position);
-  r.velocity = lerp(traj.velocity);
-  r.acceleration = lerp(traj.acceleration);
+  r.position = sample->position;
+  r.velocity = sample->velocity;
+  r.acceleration = sample->acceleration;
   return r;
 }
 

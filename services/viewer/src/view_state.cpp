@@ -9,6 +9,7 @@
 #include "ofn/common/channels.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/obstacle_messages.hpp"
+#include "ofn/common/ref_traj_sample.hpp"
 #include "ofn/common/validate.hpp"
 
 namespace ofn::viewer {
@@ -30,27 +31,6 @@ json points(const std::vector<std::vector<double>>& rows) {
 
 // The plan's position and velocity `t` s after its t0 (linear between
 // samples, held at the ends).
-/// The plan's state at `t` s after its t0, linear between its samples.
-struct PlanState {
-  Vec3 position, velocity, acceleration;
-};
-PlanState sample_plan(const ref_traj_t& plan, double t) {
-  const auto& ts = plan.sample_time;
-  auto state = [&](size_t i) {
-    auto at = [i](const std::vector<std::vector<double>>& rows) {
-      return Vec3(rows[i][0], rows[i][1], rows[i][2]);
-    };
-    return PlanState{at(plan.position), at(plan.velocity), at(plan.acceleration)};
-  };
-  if (t <= ts.front()) return state(0);
-  if (t >= ts.back()) return state(ts.size() - 1);
-  const size_t i = static_cast<size_t>(std::upper_bound(ts.begin(), ts.end(), t) - ts.begin());
-  const double w = (t - ts[i - 1]) / (ts[i] - ts[i - 1]);
-  const PlanState a = state(i - 1), b = state(i);
-  return {(1 - w) * a.position + w * b.position, (1 - w) * a.velocity + w * b.velocity,
-          (1 - w) * a.acceleration + w * b.acceleration};
-}
-
 }  // namespace
 
 const char* control_mode_name(int mode) {
@@ -280,11 +260,17 @@ json ViewState::safe_stop_json() const {
   // the acceleration limit (docs/PLANNING.md, "A safe stop from every
   // committed instant"). Needs the limit from MISSION.
   if (!ref_traj_ || !mission_) return nullptr;
-  const double t = to_seconds(ref_traj_->utime - ref_traj_->t0_utime) + config_.ref_traj_timeout;
-  const PlanState at = sample_plan(*ref_traj_, t);
-  const auto stop = stop_from(at.position, at.velocity, at.acceleration,
+  // Held at the plan's ends, as the controller holds to the last state it
+  // flew.
+  const auto& ts = ref_traj_->sample_time;
+  const double t =
+      std::clamp(to_seconds(ref_traj_->utime - ref_traj_->t0_utime) + config_.ref_traj_timeout,
+                 ts.front(), ts.back());
+  const auto at = sample_ref_traj_at(*ref_traj_, t);
+  if (!at) return nullptr;
+  const auto stop = stop_from(at->position, at->velocity, at->acceleration,
                               config_.stop_accel_fraction * mission_->limits.max_accel);
-  return json{{"start", vec(at.position)},
+  return json{{"start", vec(at->position)},
               {"point", vec(stop.stop_point())},
               {"distance", stop.distance()},
               {"time", stop.stop_time}};
