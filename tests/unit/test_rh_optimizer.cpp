@@ -164,6 +164,7 @@ TEST(RhNlp, GradientsMatchCentralDifferences) {
     for (const bool pitched : {false, true}) {
       RhSettings settings;
       settings.zero_terminal_accel = optional_rows;
+      settings.forward_speed_margin = 0.04;  // its reserve and the reserve's ramp
       RhNlp nlp(settings, BsplineBasis(settings.degree, settings.intervals));
       // Near the wall and a little inside the planned clearance, so that the
       // clearance gradient and its growing requirement are both exercised.
@@ -321,6 +322,47 @@ TEST(RhOptimizer, AClimbingLegKeepsTheWorldsVerticalSpeedLimit) {
   // twice that), and not above it beyond the resampling tolerance.
   EXPECT_LE(fastest_climb, 1.01 * open.limits.max_vertical_speed);
   EXPECT_GT(fastest_climb, 0.9 * open.limits.max_vertical_speed);
+}
+
+TEST(RhOptimizer, ASidewaysPlanKeepsItsForwardSpeedReserve) {
+  // Target 60 m beside the leg and 5 m along it, from a hover: the plan flies
+  // almost sideways. Under the forward speed rule it keeps u >= margin
+  // |v|^2 / max_speed once the reserve has built up (1 s), room for the
+  // controller's tracking error; a dead-end escape (rule relaxed) does not.
+  const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
+  RhSettings settings;
+  settings.speed_margin = 0.005;  // the service's reserves
+  settings.accel_margin = 0.06;
+  settings.forward_speed_margin = 0.04;
+  RhOptimizer optimizer(settings);
+  RhProblem problem;
+  problem.position = Vec3(0.0, 0.0, -30.0);
+  problem.target = Vec3(5.0, 60.0, -30.0);
+  problem.frame = GuidanceFrame::from_leg(problem.position, Vec3(100.0, 0.0, -30.0));
+  problem.limits = open.limits;
+  problem.terminal_x = 5.0;
+  problem.stop_at_target = true;
+  const SolveReport report = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
+  expect_meets_constraints(optimizer, problem, report, "sideways");
+  const double T = report.trajectory.duration();
+  const double max_speed = (1.0 - settings.speed_margin) * open.limits.max_speed;
+  double fastest = 0, least_reserve_kept = 1e9;
+  for (int i = 0; i <= 400; ++i) {
+    const double t = T * i / 400;
+    const Vec3 v = report.trajectory.velocity(t);
+    fastest = std::max(fastest, v.norm());
+    if (t < 1.0) continue;
+    const double reserve = settings.forward_speed_margin * v.squaredNorm() / max_speed;
+    least_reserve_kept = std::min(least_reserve_kept, v.x() - reserve);
+  }
+  EXPECT_GT(fastest, 0.5 * max_speed);  // it did fly sideways, and fast
+  EXPECT_GT(least_reserve_kept, -0.01 * max_speed);
+
+  problem.limits.min_forward_speed = -open.limits.max_speed;  // an escape
+  problem.target = Vec3(-5.0, 60.0, -30.0);
+  problem.terminal_x = -5.0;
+  const SolveReport escape = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
+  expect_meets_constraints(optimizer, problem, escape, "escape sideways and back");
 }
 
 TEST(RhOptimizer, StopsAtRestOnTheLastWaypoint) {

@@ -46,11 +46,12 @@ class PointConstraintModel {
   /// Normalised values (<= 0 met), their partial derivatives with respect
   /// to (derivative order k, guidance axis), and the derivative of each
   /// value with respect to the time t of the point (the clearance
-  /// requirement grows with t when the start is inside it).
+  /// requirement grows with t when the start is inside it; the forward
+  /// speed's reserve builds up over kForwardReserveRamp).
   struct Result {
     std::array<double, kNumPointConstraints> value{};
     std::array<Eigen::Matrix<double, 4, 3>, kNumPointConstraints> partial;
-    double clearance_time_derivative = 0;
+    std::array<double, kNumPointConstraints> time_derivative{};
   };
   void evaluate(const std::array<Vec3, 4>& state, double t, bool with_partials, Result& out) const;
 
@@ -69,6 +70,7 @@ class PointConstraintModel {
   double max_speed_;
   double start_speed_;  // |v0|, at most max_speed_
   double max_vertical_speed_, min_forward_speed_, max_accel_;
+  double forward_speed_margin_;  // 0 when the forward speed rule is relaxed
   double min_altitude_, altitude_norm_, ground_altitude_;
 };
 
