@@ -341,10 +341,12 @@ void ControllerService::control_step() {
                           limits_from(mission_->limits), x.position, x.velocity);
     mission_pending_ = false;
   }
-  // The governor holds the speed within half the stated 2 % margin.
+  // The governor acts at the limits themselves: the vehicle still overshoots
+  // what the governor allows by up to 0.15 ft/s at 10 ft/s when a curve and
+  // the yaw sweep meet (the tilt lags the heading), and that must fit in the
+  // benchmarks' 2 %. Governed at 1 % over, dense seed 43 flew 10.22 ft/s.
   const Limits limits = flight_limits();
-  const double governed = 1.0 + 0.5 * config_.gate.tolerance;
-  controller_.set_speed_limits(governed * limits.max_speed, governed * limits.max_vertical_speed);
+  controller_.set_speed_limits(limits.max_speed, limits.max_vertical_speed);
 
   const int8_t previous = mode_;
   std::optional<Reference> traj_ref;
@@ -361,8 +363,10 @@ void ControllerService::control_step() {
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;
-    if (ref_traj_->mode == ref_traj_t::LOOK_AROUND) {
-      facing = look_around_facing(path_heading_.yaw());
+    if (ref_traj_->mode == ref_traj_t::LOOK_AROUND ||
+        ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT) {
+      facing = look_around_facing(path_heading_.yaw(),
+                                  ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
     } else {
       // Where the plan will be look_ahead seconds on (or at its end).
       std::optional<Vec3> ahead;
@@ -396,8 +400,9 @@ void ControllerService::control_step() {
   if (mode_ != previous)
     node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
                      static_cast<int>(mode_), to_seconds(now));
-  const bool looking_around = mode_ == control_status_t::TRAJECTORY && ref_traj_ &&
-                              ref_traj_->mode == ref_traj_t::LOOK_AROUND;
+  const bool looking_around =
+      mode_ == control_status_t::TRAJECTORY && ref_traj_ &&
+      (ref_traj_->mode == ref_traj_t::LOOK_AROUND || ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
   const double horizontal_speed = std::hypot(x.velocity.x(), x.velocity.y());
   // The networks learn in flight; at a hover and in a look-around the
   // heading turning over a vehicle that barely moves is all they would see.
