@@ -112,13 +112,16 @@ class RecoveryRun {
     }
     return d;
   }
-  /// Turns until the recovery leaves `phase` (at most `limit` s).
-  RecoveryDecision turn_out_of(RecoveryPhase phase, double limit = 60.0) {
+  /// Turns the way the recovery says, at 0.5 rad/s, until it leaves `phase`
+  /// (at most `limit` s); `turned` gets the time it took.
+  RecoveryDecision turn_out_of(RecoveryPhase phase, double limit = 60.0, double* took = nullptr) {
     RecoveryDecision d = recovery.update(in);
-    for (double t = 0; t < limit && recovery.phase() == phase; t += 0.1) {
-      in.yaw = wrap_angle(in.yaw + 0.5 * 0.1);
+    double t = 0;
+    for (; t < limit && recovery.phase() == phase; t += 0.1) {
+      in.yaw = wrap_angle(in.yaw + (d.turn_left ? -0.5 : 0.5) * 0.1);
       d = step();
     }
+    if (took) *took = t;
     return d;
   }
   void give_route(RouteKind kind, std::vector<Vec3> points) {
@@ -184,6 +187,28 @@ TEST(DeadEndRecovery, TheLookEndsAfterAFullTurnAndARouteMadeSince) {
   const RecoveryDecision d = r.turn_out_of(RecoveryPhase::kTurning);
   EXPECT_EQ(d.phase, RecoveryPhase::kIdle);
   EXPECT_LE(std::abs(wrap_angle(r.in.yaw)), settings().face_tolerance + 0.05);
+}
+
+TEST(DeadEndRecovery, ATurnToTheWayOnTakesTheShorterWay) {
+  // Looks turn to the right; a turn to face the way on turns whichever way
+  // is shorter: a quarter turn, not three quarters (12 s more at 30 deg/s).
+  for (const double start_yaw : {1.2, -1.2}) {
+    RecoveryRun r;
+    const RecoveryDecision look = r.run(4.1);
+    ASSERT_EQ(look.phase, RecoveryPhase::kLooking);
+    EXPECT_FALSE(look.turn_left);
+    r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+    r.give_route(RouteKind::kForward, {r.in.position, Vec3(150, 0, -36.6)});
+    r.in.yaw = start_yaw;  // the leg is north: turn back to yaw 0
+    const RecoveryDecision turn = r.run(3.1);
+    ASSERT_EQ(turn.phase, RecoveryPhase::kTurning) << start_yaw;
+    EXPECT_EQ(turn.turn_left, start_yaw > 0) << start_yaw;
+    double took = 0;
+    EXPECT_EQ(r.turn_out_of(RecoveryPhase::kTurning, 60.0, &took).phase, RecoveryPhase::kIdle);
+    // (1.2 - face_tolerance) / 0.5 rad/s, then face_hold.
+    const double shorter = (1.2 - settings().face_tolerance) / 0.5 + settings().face_hold;
+    EXPECT_LE(took, shorter + 0.3) << start_yaw;
+  }
 }
 
 TEST(DeadEndRecovery, EscapesLegByLegAlongARouteThatTurnsBack) {

@@ -354,7 +354,7 @@ TEST(Validate, ModesAndStatusesOutsideTheirConstantsAreRejected) {
   ref_traj_t m = good_traj();
   m.mode = ref_traj_t::LOOK_AROUND;
   EXPECT_EQ(validate(m), "");
-  m.mode = ref_traj_t::LOOK_AROUND + 1;
+  m.mode = ref_traj_t::LOOK_AROUND_LEFT + 1;
   EXPECT_NE(validate(m), "");
   m.mode = -1;
   EXPECT_NE(validate(m), "");

@@ -178,7 +178,7 @@ std::string validate(const ref_traj_t& m) {
       !e.empty())
     return e;
   if (m.num_samples < 2) return "fewer than two samples";
-  if (m.mode < ref_traj_t::NOMINAL || m.mode > ref_traj_t::LOOK_AROUND) return "unknown mode";
+  if (m.mode < ref_traj_t::NOMINAL || m.mode > ref_traj_t::LOOK_AROUND_LEFT) return "unknown mode";
   const size_t n = m.sample_time.size();
   if (m.position.size() != n || m.velocity.size() != n || m.acceleration.size() != n)
     return "sample arrays differ in length";

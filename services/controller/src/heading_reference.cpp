@@ -53,8 +53,8 @@ std::optional<Vec3> facing_ahead(const Vec3& here, const Vec3& velocity,
   return velocity;
 }
 
-Vec3 look_around_facing(double yaw) {
-  const double ahead = yaw + 0.5 * kPi;
+Vec3 look_around_facing(double yaw, bool left) {
+  const double ahead = yaw + (left ? -0.5 : 0.5) * kPi;
   return Vec3(std::cos(ahead), std::sin(ahead), 0.0);
 }
 

@@ -86,6 +86,7 @@ void DeadEndRecovery::begin_turn(const RecoveryInput& in) {
   look_start_ = in.time;
   look_end_.reset();
   facing_since_.reset();
+  decision_.turn_left = false;
 }
 
 bool DeadEndRecovery::turned_through(const RecoveryInput& in) {
@@ -120,6 +121,7 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
     // no plan into space no beam has crossed.
     const Vec3 x = in.leg.world_from_guidance.col(0);
     face_yaw_ = std::atan2(x.y(), x.x());
+    decision_.turn_left = wrap_angle(face_yaw_ - in.yaw) < 0.0;
     after_turn_ = RecoveryPhase::kIdle;
     enter(RecoveryPhase::kTurning,
           "the route heads along the leg from here: turning to it, then normal planning");
@@ -130,6 +132,7 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
   decision_.escape_point = point;
   decision_.escape_route.assign(route.begin(), route.begin() + static_cast<std::ptrdiff_t>(*k) + 1);
   face_yaw_ = std::atan2(point.y() - in.position.y(), point.x() - in.position.x());
+  decision_.turn_left = wrap_angle(face_yaw_ - in.yaw) < 0.0;
   after_turn_ = RecoveryPhase::kEscaping;
   std::ostringstream why;
   why << "the route does not head along the leg from here: escaping along it, next to ("
@@ -180,9 +183,9 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       }
       break;
     case RecoveryPhase::kTurning: {
-      // The controller turns the heading one way at its rate; what follows
-      // starts once it faces the way it will fly (or after a full turn,
-      // whatever it faces then: the map has been swept all round).
+      // The controller turns the heading the shorter way at its rate; what
+      // follows starts once it faces the way it will fly (or after a full
+      // turn, whatever it faces then: the map has been swept all round).
       const bool turned = turned_through(in);
       const bool facing = std::abs(wrap_angle(in.yaw - face_yaw_)) <= settings_.face_tolerance;
       if (facing && !facing_since_) facing_since_ = in.time;

@@ -577,10 +577,11 @@ void RhOptimizerService::tick() {
     const bool looking = recovery.phase != RecoveryPhase::kNoRoute;
     const BsplineTrajectory hover = planner_.braking_trajectory(p);
     const Utime t0 = to_utime(t);
-    node_.publish(
-        channels::kRefTraj,
-        trajectory_message(hover, t0, looking ? ref_traj_t::LOOK_AROUND : ref_traj_t::BRAKING,
-                           config_.sample_period, now));
+    const int8_t mode = !looking             ? ref_traj_t::BRAKING
+                        : recovery.turn_left ? ref_traj_t::LOOK_AROUND_LEFT
+                                             : ref_traj_t::LOOK_AROUND;
+    node_.publish(channels::kRefTraj,
+                  trajectory_message(hover, t0, mode, config_.sample_period, now));
     last_trajectory_ = hover;
     last_trajectory_t0_ = t0;
     last_step_moving_ = false;

@@ -64,6 +64,8 @@ const char* ref_traj_mode_name(int mode) {
       return "BRAKING";
     case ref_traj_t::LOOK_AROUND:
       return "LOOK_AROUND";
+    case ref_traj_t::LOOK_AROUND_LEFT:
+      return "LOOK_AROUND_LEFT";
     default:
       return "UNKNOWN";
   }

@@ -162,8 +162,8 @@ std::optional<Vec3> facing_ahead(const Vec3& here, const Vec3& velocity,
                                  const std::optional<Vec3>& ahead, double min_speed);
 
 /// The direction to face for a look-around: a quarter turn to the right of
-/// `yaw`, so that the path heading, always turning toward it, turns at its
-/// full rate for as long as the look lasts.
-Vec3 look_around_facing(double yaw);
+/// `yaw` (to the left with `left`), so that the path heading, always turning
+/// toward it, turns at its full rate for as long as the look lasts.
+Vec3 look_around_facing(double yaw, bool left = false);
 
 }  // namespace ofn::control

@@ -79,6 +79,10 @@ struct RecoveryDecision {
   Vec3 escape_from = Vec3::Zero();
   Vec3 escape_point = Vec3::Zero();
   std::vector<Vec3> escape_route;
+  // While looking or turning: the heading turns to the left (anticlockwise
+  // seen from above). A look turns to the right; a turn to face the way on
+  // takes the shorter way (the one way round cost up to 12 s per escape leg).
+  bool turn_left = false;
 };
 
 /// Index of the first route point from which every further step heads
