@@ -102,6 +102,55 @@ TEST_F(WindyCourse, WeightsAndErrorStayBoundedOverTenMinutes) {
   EXPECT_LT(a.rms_error_second_half, 2.0 * a.rms_error_first_half + 0.5);
 }
 
+TEST(NavigationLatency, ASolutionCarriedForwardToNowKeepsTheLoopStable) {
+  // The calm course with the navigation solution 100 ms late (a slow
+  // estimator, or a link between the hosts): used as it comes, the loop
+  // commands for where the vehicle was; carried forward to now by its own
+  // kinematics (the controller's nav_prediction), it tracks as without the
+  // latency.
+  Scenario scenario = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
+  TrackingFlightConfig config;
+  config.duration = 120;
+  const TrackingResult fresh = fly_tracking(scenario, TrackingSetup{}, config);
+  scenario.disturbances.nav.latency = 0.1;
+  TrackingSetup predicted;
+  ASSERT_GE(predicted.nav_prediction, 0.1);
+  TrackingSetup as_it_comes;
+  as_it_comes.nav_prediction = 0.0;
+  const TrackingResult carried = fly_tracking(scenario, predicted, config);
+  const TrackingResult stale = fly_tracking(scenario, as_it_comes, config);
+  ASSERT_TRUE(fresh.finite);
+  ASSERT_TRUE(carried.finite);
+  EXPECT_TRUE(carried.all_valid);
+  EXPECT_LT(carried.max_error, 2.0 * fresh.max_error + 0.3)
+      << "fresh " << fresh.max_error << " m, carried forward " << carried.max_error << " m";
+  EXPECT_LT(carried.rms_error, 0.5 * stale.rms_error)
+      << "carried forward " << carried.rms_error << " m, as it comes " << stale.rms_error
+      << " m (finite: " << stale.finite << ")";
+}
+
+TEST(NavigationLatency, PredictionFollowsTheKinematicsAndIsBounded) {
+  VehicleEstimate x;
+  x.position = Vec3(1, 2, -30);
+  x.velocity = Vec3(3, 0, -1);
+  x.body_rates = Vec3(0, 0, 0.5);  // turning right at 0.5 rad/s
+  const Vec3 a(0.2, -0.4, 0);
+  const VehicleEstimate p = predict_estimate(x, a, 0.1, 0.15);
+  EXPECT_LT((p.position - (x.position + 0.1 * x.velocity + 0.5 * 0.01 * a)).norm(), 1e-12);
+  EXPECT_LT((p.velocity - (x.velocity + 0.1 * a)).norm(), 1e-12);
+  EXPECT_NEAR(p.attitude.toRotationMatrix().eulerAngles(2, 1, 0)[0], 0.05, 1e-9);
+  // Clamped to max_age; a negative, NaN or zero age changes nothing.
+  const VehicleEstimate far = predict_estimate(x, a, 5.0, 0.15);
+  EXPECT_LT((far.velocity - (x.velocity + 0.15 * a)).norm(), 1e-12);
+  for (const double age : {-0.1, kNaN, 0.0}) {
+    const VehicleEstimate same = predict_estimate(x, a, age, 0.15);
+    EXPECT_EQ(same.position, x.position);
+    EXPECT_EQ(same.velocity, x.velocity);
+  }
+  EXPECT_EQ(predict_estimate(x, Vec3(kNaN, 0, 0), 0.1, 0.15).position, x.position);
+  EXPECT_EQ(predict_estimate(x, a, 0.1, 0.0).position, x.position);
+}
+
 /// A vehicle (nominal airframe) hovering in trim, flown by a controller with
 /// or without hedging.
 struct SaturationRun {

@@ -164,7 +164,7 @@ TEST(RhNlp, GradientsMatchCentralDifferences) {
     for (const bool pitched : {false, true}) {
       RhSettings settings;
       settings.zero_terminal_accel = optional_rows;
-      settings.forward_speed_margin = 0.04;  // its reserve and the reserve's ramp
+      settings.forward_speed_reserve = 0.15;  // its reserve and the reserve's ramp
       RhNlp nlp(settings, BsplineBasis(settings.degree, settings.intervals));
       // Near the wall and a little inside the planned clearance, so that the
       // clearance gradient and its growing requirement are both exercised.
@@ -326,14 +326,14 @@ TEST(RhOptimizer, AClimbingLegKeepsTheWorldsVerticalSpeedLimit) {
 
 TEST(RhOptimizer, ASidewaysPlanKeepsItsForwardSpeedReserve) {
   // Target 60 m beside the leg and 5 m along it, from a hover: the plan flies
-  // almost sideways. Under the forward speed rule it keeps u >= margin
-  // |v|^2 / max_speed once the reserve has built up (1 s), room for the
+  // almost sideways. Under the forward speed rule it keeps u >= r |v|^2 /
+  // (|v|^2 + 1 m^2/s^2) once the reserve has built up (1 s), room for the
   // controller's tracking error; a dead-end escape (rule relaxed) does not.
   const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
   RhSettings settings;
   settings.speed_margin = 0.005;  // the service's reserves
   settings.accel_margin = 0.06;
-  settings.forward_speed_margin = 0.04;
+  settings.forward_speed_reserve = 0.15;
   RhOptimizer optimizer(settings);
   RhProblem problem;
   problem.position = Vec3(0.0, 0.0, -30.0);
@@ -352,7 +352,8 @@ TEST(RhOptimizer, ASidewaysPlanKeepsItsForwardSpeedReserve) {
     const Vec3 v = report.trajectory.velocity(t);
     fastest = std::max(fastest, v.norm());
     if (t < 1.0) continue;
-    const double reserve = settings.forward_speed_margin * v.squaredNorm() / max_speed;
+    const double reserve =
+        settings.forward_speed_reserve * v.squaredNorm() / (v.squaredNorm() + 1.0);
     least_reserve_kept = std::min(least_reserve_kept, v.x() - reserve);
   }
   EXPECT_GT(fastest, 0.5 * max_speed);  // it did fly sideways, and fast

@@ -30,6 +30,7 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.rate = r.number_in("rate_hz", c.rate, 10.0, 1000.0);
   c.status_rate = r.number_in("status_rate_hz", c.status_rate, 1.0, 1000.0);
   c.nav_timeout = r.number_in("nav_timeout", c.nav_timeout, 0.01, 10.0);
+  c.nav_prediction = r.number_in("nav_prediction", c.nav_prediction, 0.0, 1.0);
   c.ref_traj_timeout = r.number_in("ref_traj_timeout", c.ref_traj_timeout, 0.01, 10.0);
   YamlReader selector = r.child("reference_selector");
   c.selector.jump_position =
@@ -334,6 +335,9 @@ void ControllerService::control_step() {
       Quat(nav_->quaternion[0], nav_->quaternion[1], nav_->quaternion[2], nav_->quaternion[3])
           .normalized();
   x.body_rates = to_vec3(nav_->body_rates);
+  // The solution is stamped with its time of validity; the command acts now.
+  x = predict_estimate(x, to_vec3(nav_->acceleration), to_seconds(now - nav_->utime),
+                       config_.nav_prediction);
   if (!path_heading_.initialised()) path_heading_.reset(nav_->euler[2]);
 
   if (mission_pending_) {

@@ -83,6 +83,8 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
     x.velocity = nav.velocity;
     x.attitude = nav.attitude;
     x.body_rates = nav.body_rates;
+    // As the service: carried forward from its time of validity to now.
+    x = predict_estimate(x, nav.acceleration, sim.time() - nav.time, setup.nav_prediction);
     const ControlOutput out = controller.step(ref, x, dt);
     r.all_valid = r.all_valid && out.valid;
     r.all_within_limits = r.all_within_limits && within(out.controls, setup.nominal);

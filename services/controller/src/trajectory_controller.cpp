@@ -90,6 +90,20 @@ void TrajectoryController::set_speed_limits(double max_speed, double max_vertica
       std::isfinite(max_vertical_speed) ? std::max(0.0, max_vertical_speed) : 0.0;
 }
 
+VehicleEstimate predict_estimate(const VehicleEstimate& x, const Vec3& acceleration, double age,
+                                 double max_age) {
+  VehicleEstimate out = x;
+  const double dt = std::isfinite(age) ? std::clamp(age, 0.0, std::max(0.0, max_age)) : 0.0;
+  if (dt <= 0.0 || !acceleration.allFinite()) return out;
+  out.position += x.velocity * dt + 0.5 * acceleration * (dt * dt);
+  out.velocity += acceleration * dt;
+  const Vec3 turn = x.body_rates * dt;  // body axes: right-multiplied
+  if (turn.norm() > 0.0)
+    out.attitude =
+        (x.attitude * Quat(Eigen::AngleAxisd(turn.norm(), turn.normalized()))).normalized();
+  return out;
+}
+
 Vec3 TrajectoryController::govern_speed(const Vec3& accel, const Vec3& velocity) const {
   Vec3 a = accel;
   const double speed = velocity.norm();

@@ -34,6 +34,11 @@ constexpr double kHoverStartSpeed = 0.3;
 /// the reserve) cannot have it at once.
 constexpr double kForwardReserveRamp = 1.0;
 
+/// Speed (m/s) about which the forward speed's reserve sets in: the path
+/// heading holds below 1 m/s (the controller's path_heading.min_speed), and
+/// with it the heading turns that make the tracking error.
+constexpr double kForwardReserveSpeed = 1.0;
+
 // ---------------------------------------------------------------------------
 
 PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhProblem& problem,
@@ -52,9 +57,9 @@ PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhP
       max_accel_((1.0 - settings.accel_margin) * problem.limits.max_accel),
       // Only the forward speed rule of Eq. 8 gets the reserve; a dead-end
       // escape relaxes the rule to -max_speed and needs none.
-      forward_speed_margin_(problem.limits.min_forward_speed >= 0.0
-                                ? settings.forward_speed_margin
-                                : 0.0),
+      forward_speed_reserve_(problem.limits.min_forward_speed >= 0.0
+                                 ? settings.forward_speed_reserve
+                                 : 0.0),
       min_altitude_(settings.min_altitude),
       altitude_norm_(std::max(settings.min_altitude, 1.0)),
       ground_altitude_(settings.ground_altitude) {}
@@ -111,14 +116,17 @@ void PointConstraintModel::evaluate(const std::array<Vec3, 4>& state, double t, 
     out.value[kClearanceRow] = -1.0;
   }
 
-  // u >= min_forward_speed + margin |v|^2 / max_speed: a plan flying
-  // sideways keeps a little forward speed (margin * |v| at the speed limit)
-  // for the controller's tracking error. Planned at u = 0 exactly, a
-  // sideways escape at 8 ft/s while the heading swept drifted back at
-  // -0.25 ft/s, beyond the benchmarks' 2 % (dense seeds 8 and 16). Zero at
-  // a hover, so the vehicle may still stop.
+  // u >= min_forward_speed + r |v|^2 / (|v|^2 + v_r^2): a plan flying
+  // sideways keeps a little forward speed (nearly r once faster than v_r)
+  // for the controller's tracking error, which the heading's turns make
+  // and which hardly grows with speed. Planned at u = 0 exactly, sideways
+  // flights at 5-8 ft/s drifted back at -0.24 to -0.25 ft/s while the
+  // heading turned at up to 57 deg/s, beyond the benchmarks' 2 % (dense
+  // seeds 8, 16 and 20). Zero at a hover, so the vehicle may still stop.
   const double ramp = std::min(1.0, std::max(t, 0.0) / kForwardReserveRamp);
-  const double reserve = forward_speed_margin_ * velocity.squaredNorm() / max_speed_;
+  const double speed_sq = velocity.squaredNorm();
+  const double knee_sq = kForwardReserveSpeed * kForwardReserveSpeed;
+  const double reserve = forward_speed_reserve_ * speed_sq / (speed_sq + knee_sq);
   out.value[kForwardSpeedRow] = (min_forward_speed_ + ramp * reserve - velocity.x()) / max_speed_;
   if (t < kForwardReserveRamp)
     out.time_derivative[kForwardSpeedRow] = reserve / (kForwardReserveRamp * max_speed_);
@@ -138,8 +146,14 @@ void PointConstraintModel::evaluate(const std::array<Vec3, 4>& state, double t, 
   out.value[kAltitudeRow] = (min_altitude_ - altitude) / altitude_norm_;
 
   if (!with_partials) return;
-  out.partial[kForwardSpeedRow].row(1) =
-      (2.0 * ramp * forward_speed_margin_ / max_speed_) * velocity.transpose() / max_speed_;
+  {
+    const double speed_sq = velocity.squaredNorm();
+    const double knee_sq = kForwardReserveSpeed * kForwardReserveSpeed;
+    const double denominator = (speed_sq + knee_sq) * (speed_sq + knee_sq);
+    out.partial[kForwardSpeedRow].row(1) =
+        (2.0 * ramp * forward_speed_reserve_ * knee_sq / denominator) * velocity.transpose() /
+        max_speed_;
+  }
   out.partial[kForwardSpeedRow](1, 0) -= 1.0 / max_speed_;
   out.partial[kClimbSpeedRow].row(1) = -world_from_guidance_.row(2) / max_vertical_speed_;
   out.partial[kDescentSpeedRow].row(1) = world_from_guidance_.row(2) / max_vertical_speed_;

@@ -25,6 +25,7 @@ struct ControllerConfig {
   double rate = 100.0;            // Hz, control loop and ACTUATOR_CMD
   double status_rate = 50.0;      // Hz, CONTROL_STATUS
   double nav_timeout = 0.2;       // s; older navigation counts as lost
+  double nav_prediction = 0.15;   // s; navigation up to this old is carried forward to now
   double ref_traj_timeout = 0.5;  // s; an older REF_TRAJ is no longer followed
   SelectorSettings selector;      // plan jumps refused; the stop when plans go stale
   CommandGateSettings gate;       // airframe limits and geofence every command keeps

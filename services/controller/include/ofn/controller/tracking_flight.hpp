@@ -53,6 +53,9 @@ struct TrackingSetup {
   /// Of the scenario's acceleration limit: the stop whose distance the sweep
   /// covers (the controller's reference_selector.stop_accel_fraction).
   double stop_accel_fraction = 0.8;
+  /// s; navigation up to this old is carried forward to now (the
+  /// controller's nav_prediction; 0: used as it comes).
+  double nav_prediction = 0.15;
 };
 
 /// Flies the scenario's waypoints (steady wind, disturbances, airframe

@@ -38,6 +38,15 @@ struct VehicleEstimate {
   Vec3 body_rates = Vec3::Zero();
 };
 
+/// The navigation solution `age` seconds after its time of validity, by
+/// the kinematics it carries: position and velocity under the measured
+/// acceleration (world), attitude turned by the body rates. The control law
+/// acts now; fed the state of 50-100 ms ago (a navigation latency, a slow
+/// link) it commands for a vehicle that has moved on, which a loop tuned
+/// for a fresh state does not tolerate. `age` is clamped to [0, max_age].
+VehicleEstimate predict_estimate(const VehicleEstimate& x, const Vec3& acceleration, double age,
+                                 double max_age);
+
 struct ControllerGains {
   // Outer loop per world axis (north, east, down).
   Vec3 position = Vec3(0.64, 0.64, 1.0);  // 1/s^2

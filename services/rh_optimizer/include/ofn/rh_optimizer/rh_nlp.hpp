@@ -70,7 +70,7 @@ class PointConstraintModel {
   double max_speed_;
   double start_speed_;  // |v0|, at most max_speed_
   double max_vertical_speed_, min_forward_speed_, max_accel_;
-  double forward_speed_margin_;  // 0 when the forward speed rule is relaxed
+  double forward_speed_reserve_;  // m/s; 0 when the forward speed rule is relaxed
   double min_altitude_, altitude_norm_, ground_altitude_;
 };
 

@@ -11,7 +11,7 @@
 // w(T) = 0; a(T) = 0 when zero_terminal_accel.
 // Path (Eqs. 7-8), at every collocation point after the first: clearance
 // from the distance field >= the required clearance; 0 <= u (forward speed
-// >= min_forward_speed, plus forward_speed_margin's reserve); |w| <= max_vertical_speed (w the world's vertical
+// >= min_forward_speed, plus forward_speed_reserve); |w| <= max_vertical_speed (w the world's vertical
 // speed, also on a pitched leg); total speed <= max_speed;
 // the acceleration ellipse on a and, by Eq. 4 (a_c = a + tau * da/dt), on
 // the commanded acceleration; altitude >= min_altitude.
@@ -57,10 +57,10 @@ struct RhSettings {
   /// (0 here, the plain formulation; the service flies with a reserve.)
   double speed_margin = 0.0;
   double accel_margin = 0.0;
-  /// Forward speed kept by a plan flying sideways: u >= margin |v|^2 /
-  /// max_speed (margin * |v| at the speed limit) under the forward speed
-  /// rule, room for the controller's tracking error; 0 at a hover.
-  double forward_speed_margin = 0.0;
+  /// Forward speed (m/s) kept by a plan flying sideways under the forward
+  /// speed rule: u >= r |v|^2 / (|v|^2 + (1 m/s)^2), nearly r once faster
+  /// than 1 m/s, 0 at a hover; room for the controller's tracking error.
+  double forward_speed_reserve = 0.0;
   double clearance_margin = 1.0;        // m planned beyond limits.clearance (tracking error room)
   double min_altitude = 6.0;            // m above ground
   double ground_altitude = 0.0;         // m; the ground is at world z = -ground_altitude

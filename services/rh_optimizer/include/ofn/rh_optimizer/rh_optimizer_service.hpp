@@ -75,7 +75,7 @@ struct RhOptimizerServiceConfig {
     s.weights = Vec3(30.0, 30.0, 30.0);
     s.speed_margin = 0.005;
     s.accel_margin = 0.06;
-    s.forward_speed_margin = 0.04;
+    s.forward_speed_reserve = 0.15;
     s.clearance_margin = 0.5;
     return s;
   }();
