@@ -359,6 +359,15 @@ TEST(RhOptimizer, ASidewaysPlanKeepsItsForwardSpeedReserve) {
   EXPECT_GT(fastest, 0.5 * max_speed);  // it did fly sideways, and fast
   EXPECT_GT(least_reserve_kept, -0.01 * max_speed);
 
+  // A climb in place keeps no reserve (the heading holds there): from a
+  // hover to 20 m up and 0.5 m on, at rest.
+  RhProblem climb = problem;
+  climb.target = Vec3(0.5, 0.0, -50.0);
+  climb.terminal_x = 0.5;
+  const SolveReport up = optimizer.solve(climb, RhOptimizer::guess_straight(climb));
+  expect_meets_constraints(optimizer, climb, up, "climb in place");
+  EXPECT_LT((up.trajectory.position(up.trajectory.duration()) - climb.target).norm(), 0.05);
+
   problem.limits.min_forward_speed = -open.limits.max_speed;  // an escape
   problem.target = Vec3(-5.0, 60.0, -30.0);
   problem.terminal_x = -5.0;
