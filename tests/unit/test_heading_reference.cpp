@@ -96,7 +96,7 @@ TEST(PathHeading, ALookAroundTurnsAtTheBoundedRateThroughAFullTurn) {
     last = filter.yaw();
   }
   EXPECT_GE(turned, 2 * M_PI - 1e-9);
-  EXPECT_NEAR(look_around_facing(0.0).y(), 1.0, 1e-12);  // east of north: to the right
+  EXPECT_NEAR(look_around_facing(0.0).y(), 1.0, 1e-12);         // east of north: to the right
   EXPECT_NEAR(look_around_facing(0.0, true).y(), -1.0, 1e-12);  // to the left
 }
 

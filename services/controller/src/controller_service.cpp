@@ -369,8 +369,8 @@ void ControllerService::control_step() {
     ref = *traj_ref;
     if (ref_traj_->mode == ref_traj_t::LOOK_AROUND ||
         ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT) {
-      facing = look_around_facing(path_heading_.yaw(),
-                                  ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
+      facing =
+          look_around_facing(path_heading_.yaw(), ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
     } else {
       // Where the plan will be look_ahead seconds on (or at its end).
       std::optional<Vec3> ahead;
@@ -404,9 +404,9 @@ void ControllerService::control_step() {
   if (mode_ != previous)
     node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
                      static_cast<int>(mode_), to_seconds(now));
-  const bool looking_around =
-      mode_ == control_status_t::TRAJECTORY && ref_traj_ &&
-      (ref_traj_->mode == ref_traj_t::LOOK_AROUND || ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
+  const bool looking_around = mode_ == control_status_t::TRAJECTORY && ref_traj_ &&
+                              (ref_traj_->mode == ref_traj_t::LOOK_AROUND ||
+                               ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
   const double horizontal_speed = std::hypot(x.velocity.x(), x.velocity.y());
   // The networks learn in flight; at a hover and in a look-around the
   // heading turning over a vehicle that barely moves is all they would see.

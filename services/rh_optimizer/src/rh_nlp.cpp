@@ -57,9 +57,8 @@ PointConstraintModel::PointConstraintModel(const RhSettings& settings, const RhP
       max_accel_((1.0 - settings.accel_margin) * problem.limits.max_accel),
       // Only the forward speed rule of Eq. 8 gets the reserve; a dead-end
       // escape relaxes the rule to -max_speed and needs none.
-      forward_speed_reserve_(problem.limits.min_forward_speed >= 0.0
-                                 ? settings.forward_speed_reserve
-                                 : 0.0),
+      forward_speed_reserve_(
+          problem.limits.min_forward_speed >= 0.0 ? settings.forward_speed_reserve : 0.0),
       min_altitude_(settings.min_altitude),
       altitude_norm_(std::max(settings.min_altitude, 1.0)),
       ground_altitude_(settings.ground_altitude) {}

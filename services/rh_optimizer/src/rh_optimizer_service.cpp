@@ -92,8 +92,7 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   s.zero_terminal_accel = o.boolean("zero_terminal_accel", s.zero_terminal_accel);
   s.speed_margin = o.number_in("speed_margin", s.speed_margin, 0.0, 0.5);
   s.accel_margin = o.number_in("accel_margin", s.accel_margin, 0.0, 0.5);
-  s.forward_speed_reserve =
-      o.number_in("forward_speed_reserve", s.forward_speed_reserve, 0.0, 1.0);
+  s.forward_speed_reserve = o.number_in("forward_speed_reserve", s.forward_speed_reserve, 0.0, 1.0);
   s.clearance_margin = o.number_in("clearance_margin", s.clearance_margin, 0.0, 100.0);
   s.min_altitude = o.number_in("min_altitude", s.min_altitude, 0.0, 1e4);
   s.ground_altitude = o.number_in("ground_altitude", s.ground_altitude, -1e4, 1e4);

@@ -11,10 +11,11 @@
 // w(T) = 0; a(T) = 0 when zero_terminal_accel.
 // Path (Eqs. 7-8), at every collocation point after the first: clearance
 // from the distance field >= the required clearance; 0 <= u (forward speed
-// >= min_forward_speed, plus forward_speed_reserve); |w| <= max_vertical_speed (w the world's vertical
-// speed, also on a pitched leg); total speed <= max_speed;
-// the acceleration ellipse on a and, by Eq. 4 (a_c = a + tau * da/dt), on
-// the commanded acceleration; altitude >= min_altitude.
+// >= min_forward_speed, plus forward_speed_reserve); |w| <=
+// max_vertical_speed (w the world's vertical speed, also on a pitched leg);
+// total speed <= max_speed; the acceleration ellipse on a and, by Eq. 4
+// (a_c = a + tau * da/dt), on the commanded acceleration; altitude >=
+// min_altitude.
 // All constraints are normalised (divided by their limit) so one tolerance
 // fits all; gradients are analytic.
 // Pure core: world NED in and out, SI units, no LCM.
