@@ -59,8 +59,9 @@ struct RhSettings {
   double speed_margin = 0.0;
   double accel_margin = 0.0;
   /// Forward speed (m/s) kept by a plan flying sideways under the forward
-  /// speed rule: u >= r |v|^2 / (|v|^2 + (1 m/s)^2), nearly r once faster
-  /// than 1 m/s, 0 at a hover; room for the controller's tracking error.
+  /// speed rule: u >= r h^2 / (h^2 + (1 m/s)^2), h the horizontal speed:
+  /// nearly r once faster than 1 m/s, 0 at a hover or climbing in place;
+  /// room for the controller's tracking error.
   double forward_speed_reserve = 0.0;
   double clearance_margin = 1.0;        // m planned beyond limits.clearance (tracking error room)
   double min_altitude = 6.0;            // m above ground
