@@ -11,6 +11,11 @@
 namespace ofn::control {
 namespace {
 
+/// A look-around hover (either way round): the controller turns the heading.
+bool looks_around(const ref_traj_t& m) {
+  return m.mode == ref_traj_t::LOOK_AROUND || m.mode == ref_traj_t::LOOK_AROUND_LEFT;
+}
+
 Vec3 vec(const std::vector<double>& a) {
   return Vec3(a[0], a[1], a[2]);
 }
@@ -367,8 +372,7 @@ void ControllerService::control_step() {
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
     ref = *traj_ref;
-    if (ref_traj_->mode == ref_traj_t::LOOK_AROUND ||
-        ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT) {
+    if (looks_around(*ref_traj_)) {
       facing =
           look_around_facing(path_heading_.yaw(), ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
     } else {
@@ -404,9 +408,8 @@ void ControllerService::control_step() {
   if (mode_ != previous)
     node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
                      static_cast<int>(mode_), to_seconds(now));
-  const bool looking_around = mode_ == control_status_t::TRAJECTORY && ref_traj_ &&
-                              (ref_traj_->mode == ref_traj_t::LOOK_AROUND ||
-                               ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
+  const bool looking_around =
+      mode_ == control_status_t::TRAJECTORY && ref_traj_ && looks_around(*ref_traj_);
   const double horizontal_speed = std::hypot(x.velocity.x(), x.velocity.y());
   // The networks learn in flight; at a hover and in a look-around the
   // heading turning over a vehicle that barely moves is all they would see.

@@ -89,6 +89,11 @@ void DeadEndRecovery::begin_turn(const RecoveryInput& in) {
   decision_.turn_left = false;
 }
 
+void DeadEndRecovery::face(double yaw, const RecoveryInput& in) {
+  face_yaw_ = yaw;
+  decision_.turn_left = wrap_angle(yaw - in.yaw) < 0.0;  // the shorter way round
+}
+
 bool DeadEndRecovery::turned_through(const RecoveryInput& in) {
   turned_ += wrap_angle(in.yaw - last_yaw_);
   last_yaw_ = in.yaw;
@@ -120,8 +125,7 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
     // facing the way it came sees nothing ahead, and the commit gate lets
     // no plan into space no beam has crossed.
     const Vec3 x = in.leg.world_from_guidance.col(0);
-    face_yaw_ = std::atan2(x.y(), x.x());
-    decision_.turn_left = wrap_angle(face_yaw_ - in.yaw) < 0.0;
+    face(std::atan2(x.y(), x.x()), in);
     after_turn_ = RecoveryPhase::kIdle;
     enter(RecoveryPhase::kTurning,
           "the route heads along the leg from here: turning to it, then normal planning");
@@ -131,8 +135,7 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
   decision_.escape_from = in.position;
   decision_.escape_point = point;
   decision_.escape_route.assign(route.begin(), route.begin() + static_cast<std::ptrdiff_t>(*k) + 1);
-  face_yaw_ = std::atan2(point.y() - in.position.y(), point.x() - in.position.x());
-  decision_.turn_left = wrap_angle(face_yaw_ - in.yaw) < 0.0;
+  face(std::atan2(point.y() - in.position.y(), point.x() - in.position.x()), in);
   after_turn_ = RecoveryPhase::kEscaping;
   std::ostringstream why;
   why << "the route does not head along the leg from here: escaping along it, next to ("

@@ -29,8 +29,6 @@ json points(const std::vector<std::vector<double>>& rows) {
   return out;
 }
 
-// The plan's position and velocity `t` s after its t0 (linear between
-// samples, held at the ends).
 }  // namespace
 
 const char* control_mode_name(int mode) {

@@ -127,6 +127,8 @@ class DeadEndRecovery {
   /// Adds the heading turned since the last update; true after a full turn
   /// or the look's timeout.
   bool turned_through(const RecoveryInput& in);
+  /// The heading kTurning turns to, and which way round it is shorter.
+  void face(double yaw, const RecoveryInput& in);
   /// Takes up the route of `in` if it leads anywhere: normal planning or
   /// an escape. Returns false when there is none.
   bool take_route(const RecoveryInput& in);
