@@ -308,6 +308,7 @@ TEST(DistanceField, RebuildingReplacesTheWholeField) {
     for (const double second_hi : {2.5, 9.0}) {
       DistanceField reused;
       reused.build(first, 0, first_hi);
+      reused.build_all_slices();
       reused.build(second, 1, second_hi);
       DistanceField fresh;
       fresh.build(second, 1, second_hi);
@@ -319,6 +320,49 @@ TEST(DistanceField, RebuildingReplacesTheWholeField) {
             << p.transpose() << " bands " << first_hi << ", " << second_hi;
       }
     }
+  }
+}
+
+TEST(DistanceField, BuildsASliceOnlyWhenAQueryNeedsIt) {
+  Heightfield field = make_grid(30, 30, 1.0);
+  add_box(field, 10, 10, 4, 4, 12.0f);
+  DistanceField distance_field;
+  distance_field.build(field, 0, 40);
+  ASSERT_EQ(distance_field.slices(), 41);
+  EXPECT_EQ(distance_field.slices_built(), 0);
+  distance_field.query(ned_of(5, 5, 20.5));  // between slices 20 and 21
+  EXPECT_EQ(distance_field.slices_built(), 2);
+  distance_field.distance(ned_of(25, 2, 21.0));  // on slice 21, interpolating towards 22
+  EXPECT_EQ(distance_field.slices_built(), 3);
+  distance_field.distance(ned_of(25, 2, 20.2));  // both built already
+  EXPECT_EQ(distance_field.slices_built(), 3);
+  distance_field.build(field, 0, 40);
+  EXPECT_EQ(distance_field.slices_built(), 0);
+  distance_field.build_all_slices();
+  EXPECT_EQ(distance_field.slices_built(), 41);
+}
+
+TEST(DistanceField, SlicesBuiltInAnyOrderEqualAnEagerBuild) {
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 4; ++trial) {
+    const Heightfield field = random_boxes(rng, trial % 2 ? 0.5 : 1.0);
+    DistanceField eager;
+    eager.build(field, 0.5, 25);
+    eager.build_all_slices();
+    DistanceField lazy;
+    lazy.build(field, 0.5, 25);
+    // From the top down, so the slices every column reaches (which share one
+    // transform) come after the others.
+    std::uniform_real_distribution<double> north(-14, 8), east(6, 28);
+    for (double altitude = 26; altitude > -1; altitude -= 0.37) {
+      for (int n = 0; n < 20; ++n) {
+        const Vec3 p = ned_of(north(rng), east(rng), altitude);
+        const DistanceSample a = lazy.query(p), b = eager.query(p);
+        ASSERT_EQ(a.distance, b.distance) << p.transpose();
+        ASSERT_EQ(a.gradient, b.gradient) << p.transpose();
+      }
+    }
+    EXPECT_EQ(lazy.slices_built(), lazy.slices());
   }
 }
 

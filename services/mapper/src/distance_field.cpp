@@ -121,9 +121,12 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
   geometry_.cols = field.cols;
   geometry_.top.clear();
   alt_lo_ = alt_lo;
+  reaching_exterior_valid_ = false;
+  slices_built_ = 0;
   if (field.empty()) {
     slices_ = 0;
     distance_.clear();
+    slice_built_.clear();
     return;
   }
   slices_ = std::max(0, static_cast<int>(span)) + 1;
@@ -133,6 +136,7 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
   sites_.resize(cells);
   transposed_.resize(cells);
   exterior_.resize(cells);
+  reaching_exterior_.resize(cells);
   squared_.resize(cells);
   tops_transposed_.resize(cells);
   line_.resize(static_cast<size_t>(longest));
@@ -140,6 +144,7 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
   envelope_cost_.resize(static_cast<size_t>(longest));
   envelope_from_.resize(static_cast<size_t>(longest));
   distance_.resize(cells * static_cast<size_t>(slices_));
+  slice_built_.assign(static_cast<size_t>(slices_), 0);
 
   // Free cells are -inf: no exterior site, and air at every altitude.
   min_occupied_top_ = kInf;
@@ -153,12 +158,21 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
     for (int c = 0; c < field.cols; ++c)
       tops_transposed_[static_cast<size_t>(c) * field.rows + r] =
           tops_[static_cast<size_t>(r) * field.cols + c];
-  exterior_valid_ = false;
-  for (int k = 0; k < slices_; ++k)
-    build_slice(alt_lo + k * config_.vertical_resolution, distance_.data() + cells * k);
 }
 
-void DistanceField::build_slice(double altitude, float* slice_out) {
+void DistanceField::build_all_slices() const {
+  for (int k = 0; k < slices_; ++k) ensure_slice(k);
+}
+
+void DistanceField::ensure_slice(int k) const {
+  if (slice_built_[static_cast<size_t>(k)]) return;
+  const size_t cells = static_cast<size_t>(geometry_.rows) * static_cast<size_t>(geometry_.cols);
+  build_slice(alt_lo_ + k * config_.vertical_resolution, distance_.data() + cells * k);
+  slice_built_[static_cast<size_t>(k)] = 1;
+  ++slices_built_;
+}
+
+void DistanceField::build_slice(double altitude, float* slice_out) const {
   const int rows = geometry_.rows, cols = geometry_.cols;
   const size_t cells = static_cast<size_t>(rows) * cols;
   const float res = static_cast<float>(geometry_.resolution);
@@ -179,7 +193,8 @@ void DistanceField::build_slice(double altitude, float* slice_out) {
   // While every column reaches the slice the costs are all 0 / inf, so the
   // lower slices share one transform.
   const bool every_column_reaches = h <= min_occupied_top_;
-  if (!(every_column_reaches && exterior_valid_)) {
+  const float* exterior = reaching_exterior_.data();
+  if (!(every_column_reaches && reaching_exterior_valid_)) {
     for (size_t c = 0; c < cells; ++c) {
       const float below = (h - tops_[c]) * inv_res;
       sites_[c] = below > 0 ? below * below : 0.0f;
@@ -193,10 +208,12 @@ void DistanceField::build_slice(double altitude, float* slice_out) {
     for (int c = 0; c < cols; ++c)
       transform_1d(transposed + static_cast<size_t>(c) * rows, rows, cap, squared_.data() + c, cols,
                    site, site_cost, from);
-    for (size_t c = 0; c < cells; ++c) exterior_[c] = to_distance(squared_[c]);
-    exterior_valid_ = every_column_reaches;
+    float* out = every_column_reaches ? reaching_exterior_.data() : exterior_.data();
+    for (size_t c = 0; c < cells; ++c) out[c] = to_distance(squared_[c]);
+    if (every_column_reaches) reaching_exterior_valid_ = true;
+    exterior = out;
   }
-  std::copy(exterior_.begin(), exterior_.end(), slice_out);
+  std::copy(exterior, exterior + cells, slice_out);
 
   // Interior: cells whose column rises above the slice. Their depth is the
   // same transform with air (cost 0) as the sites and each column's height
@@ -253,6 +270,8 @@ double DistanceField::sample(const Vec3& ned, Vec3* gradient) const {
   const AxisCell north = locate((ned.x() - geometry_.origin_north) / res - 0.5, geometry_.rows);
   const AxisCell east = locate((ned.y() - geometry_.origin_east) / res - 0.5, geometry_.cols);
   const AxisCell up = locate((-ned.z() - alt_lo_) / config_.vertical_resolution, slices_);
+  ensure_slice(up.index);
+  if (up.step) ensure_slice(up.index + 1);
 
   const std::ptrdiff_t cols = geometry_.cols;
   const std::ptrdiff_t slice = static_cast<std::ptrdiff_t>(geometry_.rows) * cols;

@@ -13,6 +13,12 @@
 // negative distance to the nearest air (beside it, or above its top), so
 // the sign changes half-way between an obstacle centre and a free one and the
 // gradient points out.
+//
+// Slices are transformed on first use: a flight at one altitude queries a few
+// of the band's slices, and the transform is most of the planner's work. A
+// lazily built slice is the same, bit for bit, as an eagerly built one. The
+// first query of a slice writes into the field, so a DistanceField is not for
+// concurrent queries from several threads.
 
 #include <vector>
 
@@ -36,13 +42,16 @@ class DistanceField {
   DistanceField() = default;
   explicit DistanceField(const DistanceFieldConfig& config) : config_(config) {}
 
-  /// Builds the field over the heightfield's footprint for altitudes
+  /// Sets the field over the heightfield's footprint for altitudes
   /// [alt_lo, alt_hi] (m above ground; slices every vertical_resolution from
   /// alt_lo up to the first one at or above alt_hi). Cells above
-  /// `occupied_above` count as obstacle columns. Throws std::invalid_argument
-  /// on a non-positive resolution or max_distance, alt_hi < alt_lo, or a top
+  /// `occupied_above` count as obstacle columns. Each slice is transformed
+  /// when a query first needs it. Throws std::invalid_argument on a
+  /// non-positive resolution or max_distance, alt_hi < alt_lo, or a top
   /// vector that does not match rows * cols.
   void build(const Heightfield& field, double alt_lo, double alt_hi, double occupied_above = 0.5);
+  /// Transforms every slice now (for a caller that wants the cost up front).
+  void build_all_slices() const;
 
   bool empty() const { return slices_ == 0; }
   /// Distance and gradient at a world NED point. The interpolant spans the
@@ -55,34 +64,42 @@ class DistanceField {
 
   const DistanceFieldConfig& config() const { return config_; }
   int slices() const { return slices_; }
+  /// Slices transformed since the last build().
+  int slices_built() const { return slices_built_; }
   double altitude_low() const { return alt_lo_; }
 
  private:
   template <bool kWithGradient>
   double sample(const Vec3& ned, Vec3* gradient) const;
+  // Slice k, unless it is built already.
+  void ensure_slice(int k) const;
   // One slice: the exterior transform into slice_out, then the interior
   // depth over the cells still inside a column.
-  void build_slice(double altitude, float* slice_out);
+  void build_slice(double altitude, float* slice_out) const;
 
   DistanceFieldConfig config_;
   Heightfield geometry_;  // top left empty; only the grid geometry is kept
   double alt_lo_ = 0;
   int slices_ = 0;
-  std::vector<float> distance_;  // slices_ * rows * cols
-
-  // Scratch reused across builds; squared distances are in cells^2.
   std::vector<float> tops_;             // rows * cols; -inf where free
-  std::vector<float> sites_;            // rows * cols, initial cost of one transform
-  std::vector<float> transposed_;       // cols * rows, after the pass along rows
-  std::vector<float> exterior_;         // rows * cols, exterior distance of the last slice
   std::vector<float> tops_transposed_;  // cols * rows
-  std::vector<float> squared_;          // rows * cols, squared exterior distance
-  std::vector<float> line_;             // one run of inside cells along a column
-  std::vector<int> envelope_site_;      // lower envelope: parabola apexes
-  std::vector<float> envelope_cost_;    // ... their initial costs
-  std::vector<float> envelope_from_;    // ... and where each starts to be lowest
   float min_occupied_top_ = 0;
-  bool exterior_valid_ = false;  // exterior_ holds the slices every column reaches
+
+  // Filled slice by slice as queries need them (see the class comment).
+  mutable std::vector<float> distance_;    // slices_ * rows * cols
+  mutable std::vector<char> slice_built_;  // per slice
+  mutable int slices_built_ = 0;
+  // Scratch reused across slices and builds; squared distances are in cells^2.
+  mutable std::vector<float> sites_;              // rows * cols, initial cost of one transform
+  mutable std::vector<float> transposed_;         // cols * rows, after the pass along rows
+  mutable std::vector<float> exterior_;           // rows * cols, exterior distance of one slice
+  mutable std::vector<float> reaching_exterior_;  // ... of the slices every column reaches
+  mutable std::vector<float> squared_;            // rows * cols, squared exterior distance
+  mutable std::vector<float> line_;               // one run of inside cells along a column
+  mutable std::vector<int> envelope_site_;        // lower envelope: parabola apexes
+  mutable std::vector<float> envelope_cost_;      // ... their initial costs
+  mutable std::vector<float> envelope_from_;      // ... and where each starts to be lowest
+  mutable bool reaching_exterior_valid_ = false;
 };
 
 }  // namespace ofn::mapping
