@@ -268,6 +268,47 @@ TEST(OccupancyMap, ForgetFarKeepsAWideNeighbourhoodIntact) {
   EXPECT_EQ(voxel_at(map, at_altitude(0.5, 0.5, 10.5)), Voxel::kOccupied);
 }
 
+TEST(OccupancyMap, ForgetFarKeepsEveryLeafWithinTheRadiusUnchanged) {
+  OccupancyMapConfig config = unit_config();
+  config.forget_radius = 23.0;
+  // Centres on a node boundary, inside a node, and far from the carved area.
+  for (const Vec3& centre : {Vec3(0, 0, 0), Vec3(5.3, -3.7, 0), Vec3(-31.0, 17.2, 0)}) {
+    OccupancyMap map(config);
+    for (int k = 0; k < 12; ++k) {
+      const double a = 2.0 * kPi * k / 12.0;
+      const Vec3 sensor = at_altitude(40.0 * std::cos(a), 40.0 * std::sin(a), 10.5);
+      map.insert_scan(sensor, {at_altitude(0.5, 0.5, 10.5), at_altitude(-8.5, 12.5, 3.5)},
+                      {at_altitude(0.5, 0.5, 40.0), at_altitude(20.5, -30.5, 1.0)});
+    }
+    struct Leaf {
+      Vec3 centre;
+      unsigned depth;
+      float log_odds;
+    };
+    std::vector<Leaf> kept;
+    size_t far_leaves = 0;
+    for (auto it = map.tree().begin_leafs(), end = map.tree().end_leafs(); it != end; ++it) {
+      if (std::hypot(it.getX() - centre.x(), it.getY() - centre.y()) <= config.forget_radius)
+        kept.push_back({Vec3(it.getX(), it.getY(), it.getZ()), it.getDepth(), it->getLogOdds()});
+      else
+        ++far_leaves;
+    }
+    ASSERT_GT(kept.size(), 100u);
+    ASSERT_GT(far_leaves, 100u);
+    map.forget_far(centre.x(), centre.y());
+    size_t leaves_after = 0;
+    for (auto it = map.tree().begin_leafs(), end = map.tree().end_leafs(); it != end; ++it)
+      ++leaves_after;
+    EXPECT_EQ(leaves_after, kept.size()) << "centre " << centre.transpose();
+    for (const Leaf& leaf : kept) {
+      const auto* node =
+          map.tree().search(leaf.centre.x(), leaf.centre.y(), leaf.centre.z(), leaf.depth);
+      ASSERT_NE(node, nullptr) << leaf.centre.transpose();
+      ASSERT_EQ(node->getLogOdds(), leaf.log_odds) << leaf.centre.transpose();
+    }
+  }
+}
+
 TEST(OccupancyMap, RejectsBadConfigNamingTheField) {
   OccupancyMapConfig config = unit_config();
   config.prob_miss = 0.6;

@@ -208,10 +208,18 @@ class FarVoxelRemover {
   // Removes the far parts below `node` and tells whether everything below
   // it (or the node itself, for a leaf) is far, leaving that to the caller.
   bool drop_all(octomap::OcTreeNode* node, double north, double east, double size) {
-    if (!tree_.nodeHasChildren(node)) {
-      const double dn = north - north_, de = east - east_;
-      return dn * dn + de * de > radius_sq_;
-    }
+    const double dn = std::abs(north - north_), de = std::abs(east - east_);
+    if (!tree_.nodeHasChildren(node)) return dn * dn + de * de > radius_sq_;
+    // Most of the tree lies wholly inside the circle (or wholly outside):
+    // such a node is decided by its box, without visiting what is below it.
+    // Every leaf centre below lies within the box, so the answer is the one
+    // the leaves would give, and the inner occupancies are already up to
+    // date (nodes are updated without lazy evaluation).
+    const double half = 0.5 * size;
+    const double far_n = dn + half, far_e = de + half;
+    if (far_n * far_n + far_e * far_e <= radius_sq_) return false;
+    const double near_n = std::max(0.0, dn - half), near_e = std::max(0.0, de - half);
+    if (near_n * near_n + near_e * near_e > radius_sq_) return true;
     bool drop[8] = {};
     bool all = true;
     const double quarter = 0.25 * size;
