@@ -141,15 +141,18 @@ enum class Start { kCold, kWarm };
 
 // stride: solve every stride-th problem of the sequence (MMA is slow enough
 // that the whole sequence would dominate the run).
-void run_sequence(benchmark::State& state, Start start, RhAlgorithm algorithm, size_t stride = 1) {
+void run_sequence(benchmark::State& state, Start start, RhAlgorithm algorithm, size_t stride = 1,
+                  double screening_margin = 0.0) {
   const std::vector<RecordedProblem>& all = recorded_flight();
   std::vector<RecordedProblem> problems;
   for (size_t i = 0; i < all.size(); i += stride) problems.push_back(all[i]);
   RhSettings settings;
   settings.algorithm = algorithm;
+  settings.screening_margin = screening_margin;
   RhOptimizer optimizer(settings);
   std::vector<double> times;
   long evaluations = 0, feasible = 0;
+  double cost_sum = 0;
   for (auto _ : state) {
     for (const RecordedProblem& recorded : problems) {
       const InitialGuess guess =
@@ -163,6 +166,7 @@ void run_sequence(benchmark::State& state, Start start, RhAlgorithm algorithm, s
           std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
       evaluations += report.iterations;
       feasible += report.feasible ? 1 : 0;
+      if (report.feasible) cost_sum += report.cost;
     }
   }
   std::sort(times.begin(), times.end());
@@ -176,6 +180,8 @@ void run_sequence(benchmark::State& state, Start start, RhAlgorithm algorithm, s
   state.counters["max_ms"] = 1e3 * times.back();
   state.counters["mean_evaluations"] = static_cast<double>(evaluations) / solves;
   state.counters["feasible_share"] = static_cast<double>(feasible) / solves;
+  state.counters["mean_feasible_cost"] =
+      feasible > 0 ? cost_sum / static_cast<double>(feasible) : 0;
 }
 
 void BM_RhSolveCold(benchmark::State& state) {
@@ -187,7 +193,25 @@ void BM_RhSolveWarm(benchmark::State& state) {
 void BM_RhSolveWarmMma(benchmark::State& state) {
   run_sequence(state, Start::kWarm, RhAlgorithm::kMma, 4);
 }
+void BM_RhSolveColdScreened(benchmark::State& state) {
+  run_sequence(state, Start::kCold, RhAlgorithm::kSlsqp, 1, state.range(0) / 100.0);
+}
+void BM_RhSolveWarmScreened(benchmark::State& state) {
+  run_sequence(state, Start::kWarm, RhAlgorithm::kSlsqp, 1, state.range(0) / 100.0);
+}
 BENCHMARK(BM_RhSolveCold)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RhSolveColdScreened)
+    ->Arg(25)
+    ->Arg(50)
+    ->Arg(100)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RhSolveWarmScreened)
+    ->Arg(25)
+    ->Arg(50)
+    ->Arg(100)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RhSolveWarm)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RhSolveWarmMma)->Iterations(1)->Unit(benchmark::kMillisecond);
 

@@ -423,6 +423,56 @@ TEST_P(RhOptimizerCourse, FeasibleAtEveryStartAndBetweenCollocationPoints) {
   }
 }
 
+TEST_P(RhOptimizerCourse, ScreeningKeepsEveryConstraintAndTheCost) {
+  // Warm solves (the only ones screened) a step along the full solution,
+  // with and without screening.
+  const CourseCase& c = GetParam();
+  const Course course = load_course(c.name, c.route_feet);
+  RhOptimizer full;
+  RhSettings settings;
+  settings.screening_margin = 0.5;
+  RhOptimizer screened(settings);
+  const int all_rows = full.settings().collocation_points * kNumPointConstraints + 4;
+  int rounds_above_one = 0;
+  for (const double start_x : c.starts_feet) {
+    const std::string label = c.name + " from x = " + std::to_string(start_x) + " ft";
+    const Vec3 position = route_at(course.route, start_x * kMetresPerFoot);
+    const RhProblem problem = course_problem(course, position);
+    const InitialGuess guess =
+        RhOptimizer::guess_from_path(course.route, problem, course.scenario.cruise_speed);
+    const SolveReport cold = full.solve(problem, guess);
+    ASSERT_TRUE(cold.feasible) << label;
+    EXPECT_EQ(screened.solve(problem, guess).subproblem_rows, all_rows) << label << ", cold";
+    for (const double step : {0.1, 1.0, 3.0}) {
+      RhProblem next = problem;
+      next.position = cold.trajectory.position(step);
+      next.velocity = cold.trajectory.velocity(step);
+      next.acceleration = cold.trajectory.acceleration(step);
+      const InitialGuess warm = RhOptimizer::guess_from_previous(cold.trajectory, step, next);
+      const std::string at = label + ", warm " + std::to_string(step) + " s on";
+      const SolveReport reference = full.solve(next, warm);
+      const SolveReport report = screened.solve(next, warm);
+      ASSERT_TRUE(reference.feasible) << at;
+      ASSERT_TRUE(report.feasible) << at << ": " << report.message;
+      EXPECT_LT(report.subproblem_rows, all_rows) << at;
+      EXPECT_LE(report.cost, 1.01 * reference.cost) << at;
+      // Every row at the collocation points, left out or not; between them
+      // no worse than the full solve (a warm start from an arbitrary state
+      // can bulge there either way).
+      const int points = screened.settings().collocation_points;
+      EXPECT_LE(screened.check(next, report.trajectory, points).worst(),
+                screened.settings().feasibility_tolerance + 1e-9)
+          << at;
+      const double fine = screened.check(next, report.trajectory, 10 * points).worst();
+      const double fine_full = full.check(next, reference.trajectory, 10 * points).worst();
+      EXPECT_LE(fine, std::max(kBetweenPointsTolerance, fine_full + 0.01)) << at;
+      rounds_above_one += report.rounds > 1 ? 1 : 0;
+    }
+  }
+  // Rows left out at the start joined in some solves: that path is flown too.
+  EXPECT_GT(rounds_above_one, 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Benchmarks, RhOptimizerCourse,
     ::testing::Values(

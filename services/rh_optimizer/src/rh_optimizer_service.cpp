@@ -103,6 +103,9 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   s.max_solve_time = o.number_in("max_solve_time", s.max_solve_time, 0.001, 10.0);
   s.feasibility_tolerance =
       o.number_in("feasibility_tolerance", s.feasibility_tolerance, 1e-8, 0.5);
+  s.screening_margin = o.number_in("screening_margin", s.screening_margin, 0.0, 100.0);
+  s.max_screening_rounds = o.integer("max_screening_rounds", s.max_screening_rounds);
+  if (s.max_screening_rounds < 1) o.fail("max_screening_rounds", "must be >= 1");
   const std::string algorithm =
       o.text("algorithm", s.algorithm == RhAlgorithm::kMma ? "mma" : "slsqp");
   if (algorithm == "slsqp")

@@ -72,6 +72,13 @@ struct RhSettings {
   double max_solve_time = 0.05;         // s of wall time per solve
   double feasibility_tolerance = 2e-3;  // worst normalised violation accepted as feasible
   RhAlgorithm algorithm = RhAlgorithm::kSlsqp;
+  /// Constraint screening: a path-constraint row further than this below
+  /// its limit (normalised, as in ConstraintReport) where the solve starts
+  /// is left out of the optimiser's subproblem; rows the result comes this
+  /// near (or breaks) are added and the solve goes on from there. Every
+  /// point is still judged feasible against every row. 0: all rows always.
+  double screening_margin = 0.0;
+  int max_screening_rounds = 3;  // solves per call with rows added between them
 };
 
 /// Clearance (m, negative inside) and its gradient at a world NED point.
@@ -120,6 +127,8 @@ struct SolveReport {
   double max_violation = 0;  // worst normalised violation at the collocation points
   double cost = 0;           // Eq. 1
   bool warm_started = false;
+  int rounds = 0;                // optimiser runs (more than 1 when screened rows joined)
+  int subproblem_rows = 0;       // inequality rows the last run carried
   std::string message;           // NLopt's result and anything notable
   BsplineTrajectory trajectory;  // world NED, t from the problem's time
 };
