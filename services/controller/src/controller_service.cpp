@@ -84,6 +84,8 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.gains.max_vertical_accel =
       outer.number_in("max_vertical_accel", c.gains.max_vertical_accel, 0.1, 20.0);
   c.gains.max_tilt = deg2rad(outer.number_in("max_tilt_deg", rad2deg(c.gains.max_tilt), 1.0, 60.0));
+  c.gains.governor_over_limit =
+      outer.number_in("governor_over_limit", c.gains.governor_over_limit, 1.0, 10.0);
   c.gains.outer_reference_frequency =
       outer.number_in("reference_frequency", c.gains.outer_reference_frequency, 0.05, 20.0);
   c.gains.outer_reference_damping =

@@ -58,6 +58,11 @@ struct ControllerGains {
   double max_horizontal_accel = 5.0;  // m/s^2, pseudo-control bound
   double max_vertical_accel = 3.0;    // m/s^2
   double max_tilt = deg2rad(35.0);    // rad
+  // Above a speed limit the governor brakes at this many times the velocity
+  // gain. What it must overcome there is acceleration the vehicle makes
+  // unasked (the tilt lagging a sweeping heading); at the plain gain an
+  // unasked 0.1 m/s^2 holds the vehicle 0.07 m/s (2.2 % of 10 ft/s) over.
+  double governor_over_limit = 3.0;
   // Inner loop per body axis (roll, pitch, yaw).
   Vec3 attitude = Vec3(9.0, 9.0, 4.0);           // 1/s^2
   Vec3 rate = Vec3(4.8, 4.8, 4.0);               // 1/s
@@ -141,7 +146,8 @@ class TrajectoryController {
   /// (m/s, up or down), so that neither the reference model catching up with
   /// a plan it lags nor the feedback on a position error drives the vehicle
   /// beyond the limits, whatever the plan. Near and below them it acts as a
-  /// velocity loop saturated at the limit; far below it does nothing.
+  /// velocity loop saturated at the limit (braking harder above it, by
+  /// `governor_over_limit`); far below it does nothing.
   /// Zero turns a limit off (the default).
   void set_speed_limits(double max_speed, double max_vertical_speed);
   /// Holds the adaptive element's weights (it still adds what it has
