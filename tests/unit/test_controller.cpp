@@ -270,6 +270,19 @@ TEST(TrajectoryController, AStopFromASidewaysCruiseDoesNotDriftBack) {
   EXPECT_GT(least_north_speed_in_a_stop(kStopRampTime), -0.02 * 3.048);
 }
 
+/// At time t, a reference `lead` metres ahead along `direction` that
+/// speeds up from rest at `accel` to `speed` and keeps it.
+Reference speeding_up(const Vec3& direction, double speed, double accel, double lead, double t) {
+  const double ramp = speed / accel;
+  const double along =
+      t < ramp ? 0.5 * accel * t * t : 0.5 * accel * ramp * ramp + speed * (t - ramp);
+  Reference ref;
+  ref.position = direction * (lead + along);
+  ref.velocity = direction * std::min(speed, accel * t);
+  ref.acceleration = direction * (t < ramp ? accel : 0.0);
+  return ref;
+}
+
 /// The largest speed (3-D, and vertical) flown from a hover while the
 /// reference, `lead` metres ahead along `direction`, speeds up from rest at
 /// `accel` to `speed` and keeps it: with a lead, a plan restarted ahead of a
@@ -279,16 +292,8 @@ std::pair<double, double> fastest_chasing(const Vec3& direction, double speed, d
                                           double max_vertical_speed) {
   ClosedLoop loop(max_speed, max_vertical_speed);
   double fastest = 0, fastest_vertical = 0;
-  const double ramp = speed / accel;
   for (int i = 0; i < static_cast<int>(30.0 / kControlDt); ++i) {
-    const double t = i * kControlDt;
-    const double along =
-        t < ramp ? 0.5 * accel * t * t : 0.5 * accel * ramp * ramp + speed * (t - ramp);
-    Reference ref;
-    ref.position = direction * (lead + along);
-    ref.velocity = direction * std::min(speed, accel * t);
-    ref.acceleration = direction * (t < ramp ? accel : 0.0);
-    loop.step(ref);
+    loop.step(speeding_up(direction, speed, accel, lead, i * kControlDt));
     fastest = std::max(fastest, loop.state().velocity.norm());
     fastest_vertical = std::max(fastest_vertical, std::abs(loop.state().velocity.z()));
   }
@@ -328,13 +333,7 @@ double fastest_pushed(double limit, double unasked, double over_limit_gain) {
   const double ramp = limit / accel;
   for (int i = 0; i < static_cast<int>(40.0 / kControlDt); ++i) {
     const double t = i * kControlDt;
-    const double along =
-        t < ramp ? 0.5 * accel * t * t : 0.5 * accel * ramp * ramp + limit * (t - ramp);
-    Reference ref;
-    ref.position = Vec3(along, 0, 0);
-    ref.velocity = Vec3(std::min(limit, accel * t), 0, 0);
-    ref.acceleration = Vec3(t < ramp ? accel : 0.0, 0, 0);
-    loop.step(ref);
+    loop.step(speeding_up(Vec3::UnitX(), limit, accel, 0.0, t));
     // The push, after the vehicle is up to speed: its velocity gains what
     // the airframe was not asked for.
     if (t > ramp + 5.0) loop.push(Vec3(unasked * kControlDt, 0, 0));
