@@ -193,19 +193,10 @@ void BM_RhSolveWarm(benchmark::State& state) {
 void BM_RhSolveWarmMma(benchmark::State& state) {
   run_sequence(state, Start::kWarm, RhAlgorithm::kMma, 4);
 }
-void BM_RhSolveColdScreened(benchmark::State& state) {
-  run_sequence(state, Start::kCold, RhAlgorithm::kSlsqp, 1, state.range(0) / 100.0);
-}
 void BM_RhSolveWarmScreened(benchmark::State& state) {
   run_sequence(state, Start::kWarm, RhAlgorithm::kSlsqp, 1, state.range(0) / 100.0);
 }
 BENCHMARK(BM_RhSolveCold)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_RhSolveColdScreened)
-    ->Arg(25)
-    ->Arg(50)
-    ->Arg(100)
-    ->Iterations(1)
-    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RhSolveWarmScreened)
     ->Arg(25)
     ->Arg(50)

@@ -432,7 +432,8 @@ TEST_P(RhOptimizerCourse, ScreeningKeepsEveryConstraintAndTheCost) {
   RhSettings settings;
   settings.screening_margin = 0.5;
   RhOptimizer screened(settings);
-  const int all_rows = full.settings().collocation_points * kNumPointConstraints + 4;
+  const int all_rows =
+      full.settings().collocation_points * kNumPointConstraints + RhNlp::kNumTerminalInequalities;
   int rounds_above_one = 0;
   for (const double start_x : c.starts_feet) {
     const std::string label = c.name + " from x = " + std::to_string(start_x) + " ft";

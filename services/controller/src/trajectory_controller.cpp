@@ -106,19 +106,21 @@ VehicleEstimate predict_estimate(const VehicleEstimate& x, const Vec3& accelerat
 
 Vec3 TrajectoryController::govern_speed(const Vec3& accel, const Vec3& velocity) const {
   Vec3 a = accel;
+  // The acceleration allowed towards a limit `left` away (negative: over it).
+  const auto cap_for = [&](double velocity_gain, double left) {
+    return velocity_gain * (left >= 0 ? 1.0 : gains_.governor_over_limit) * left;
+  };
   const double speed = velocity.norm();
   if (governed_speed_ > 0 && speed > 1e-6) {
     const Vec3 along = velocity / speed;
-    const double left = governed_speed_ - speed;
-    const double cap = gains_.velocity.x() * (left >= 0 ? 1.0 : gains_.governor_over_limit) * left;
+    const double cap = cap_for(gains_.velocity.x(), governed_speed_ - speed);
     const double excess = a.dot(along) - cap;
     if (excess > 0) a -= excess * along;
   }
   if (governed_vertical_speed_ > 0) {
     const double climb = std::abs(velocity.z());
     const double sign = velocity.z() >= 0 ? 1.0 : -1.0;
-    const double left = governed_vertical_speed_ - climb;
-    const double cap = gains_.velocity.z() * (left >= 0 ? 1.0 : gains_.governor_over_limit) * left;
+    const double cap = cap_for(gains_.velocity.z(), governed_vertical_speed_ - climb);
     if (sign * a.z() > cap) a.z() = sign * cap;
   }
   return a;

@@ -271,7 +271,7 @@ void RhNlp::set_problem(const RhProblem& problem) {
 
 int RhNlp::num_inequalities() const {
   const int per_point = kNumPointConstraints - (has_clearance_ ? 0 : 1);
-  return tables_.collocation * per_point + 4;
+  return tables_.collocation * per_point + kNumTerminalInequalities;
 }
 
 int RhNlp::num_equalities() const {

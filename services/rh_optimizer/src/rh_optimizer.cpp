@@ -383,7 +383,7 @@ SolveReport RhOptimizer::solve(const RhProblem& problem, const InitialGuess& gue
 
   // Screening: most rows (the clearance far from anything, the speed at a
   // hover) are nowhere near their limits, and the subproblem's cost grows
-  // with the rows it carries. The terminal rows (the last four) always stay.
+  // with the rows it carries. The terminal rows (the last ones) always stay.
   // Only from a warm guess: a cold one is far from the solution, and with
   // the acceleration rows left out its first steps run off to points the
   // next round cannot come back from (measured: from the global path, 59 %
@@ -396,7 +396,8 @@ SolveReport RhOptimizer::solve(const RhProblem& problem, const InitialGuess& gue
     int added = 0;
     for (int r = 0; r < m_ineq; ++r) {
       if (in_subproblem[static_cast<size_t>(r)]) continue;
-      if (r >= m_ineq - 4 || !(context.inequality_values(r) <= -margin)) {
+      if (r >= m_ineq - RhNlp::kNumTerminalInequalities ||
+          !(context.inequality_values(r) <= -margin)) {
         in_subproblem[static_cast<size_t>(r)] = 1;
         ++added;
       }

@@ -105,6 +105,8 @@ class RhNlp {
   double cost_scale() const { return cost_scale_; }
 
   int num_variables() const { return 3 * tables_.free_per_axis + 1; }
+  /// The terminal speed rows (Eq. 6), the last of the inequalities.
+  static constexpr int kNumTerminalInequalities = 4;
   int num_inequalities() const;
   int num_equalities() const;
   /// Bounds of z (T bounded by the settings; control points generously).
