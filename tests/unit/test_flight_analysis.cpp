@@ -568,5 +568,38 @@ TEST(AnalyseFlight, AModeAddedLaterToFlyAPlanIsJudged) {
   EXPECT_TRUE(flies_a_plan(kUnknownMode));
 }
 
+TEST(ScanToPlan, FromEachScanToTheFirstStepOnAMapHoldingIt) {
+  // Steps at 10 Hz from t = 1.0 to 2.0 s, each on the newest map built by
+  // then at 5 Hz (built 0.02 s after the scan it holds); scans at 12.5 Hz.
+  std::vector<PlanStep> steps;
+  for (int i = 0; i <= 10; ++i) {  // in ms, exact
+    const int t = 1000 + 100 * i;
+    const int built = (t - 20) / 200 * 200;  // the last field build
+    const int newest_scan = built / 80 * 80;
+    steps.push_back({t / 1000.0, newest_scan / 1000.0});
+  }
+  std::vector<double> scans;
+  for (int k = 0; k <= 30; ++k) scans.push_back(80 * k / 1000.0);
+  const std::vector<double> latencies = scan_to_plan_latencies(scans, steps);
+  // Scans before planning began are not counted, nor those after it ended
+  // (no step planned on them).
+  ASSERT_FALSE(latencies.empty());
+  for (double l : latencies) {
+    EXPECT_GE(l, 0.0);
+    EXPECT_LE(l, 0.2 + 0.1 + 0.08 + 1e-9);  // a field period, a step period, a scan period
+  }
+  // By hand: the scan at 1.04 s is in the map built at 1.2 s (newest scan
+  // 1.12 s), planned on first by the step at 1.3 s.
+  const std::vector<double> one = scan_to_plan_latencies({1.04}, steps);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_NEAR(one[0], 1.3 - 1.04, 1e-9);
+
+  // A pause in planning: a scan before it is answered by no step after it.
+  std::vector<PlanStep> paused = {{1.0, 0.96}, {1.1, 0.96}, {5.0, 4.96}};
+  EXPECT_TRUE(scan_to_plan_latencies({1.05}, paused).empty());
+  EXPECT_TRUE(scan_to_plan_latencies({0.5}, paused).empty());  // before planning
+  EXPECT_TRUE(scan_to_plan_latencies({}, paused).empty());
+}
+
 }  // namespace
 }  // namespace ofn::report

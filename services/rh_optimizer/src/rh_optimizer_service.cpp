@@ -366,6 +366,7 @@ bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
   const double lo = std::max(0.0, alt - config_.field_altitude_band);
   const double hi = std::max(lo + 1.0, alt + config_.field_altitude_band);
   field_.build(heightfield_, lo, hi);
+  field_map_utime_ = grid_->utime;
   field_valid_ = true;
   field_built_ = now;
   field_altitude_ = vehicle_altitude;
@@ -451,6 +452,7 @@ void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::stri
     s.cost = std::isfinite(report->cost) ? report->cost : 0.0;
     s.warm_started = report->warm_started;
   }
+  s.map_utime = field_valid_ ? field_map_utime_ : 0;
   node_.publish(channels::kSolverStats, s);
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
 #include "ofn/control_status_t.hpp"
@@ -188,6 +189,30 @@ Verdict judge_flight(const FlightSummary& s, const Limits& limits,
     v.outcome = goal_reached ? Outcome::kSuccess : Outcome::kSafeStop;
   v.success = v.outcome == Outcome::kSuccess;
   return v;
+}
+
+std::vector<double> scan_to_plan_latencies(const std::vector<double>& map_stamps,
+                                           const std::vector<PlanStep>& steps, double active_gap) {
+  std::vector<double> latencies;
+  for (const double stamp : map_stamps) {
+    // The first step published at or after the stamp; the one before it
+    // says whether the optimiser was planning then.
+    const auto after =
+        std::lower_bound(steps.begin(), steps.end(), stamp,
+                         [](const PlanStep& step, double t) { return step.published < t; });
+    if (after == steps.begin() || stamp - std::prev(after)->published > active_gap) continue;
+    // Planning must go on until then: after a pause (avoidance handed
+    // back) the next step is not this scan's answer.
+    double last = std::prev(after)->published;
+    for (auto it = after; it != steps.end() && it->published - last <= active_gap; ++it) {
+      if (it->map >= stamp) {
+        latencies.push_back(it->published - stamp);
+        break;
+      }
+      last = it->published;
+    }
+  }
+  return latencies;
 }
 
 std::optional<Clearance> least_clearance(const std::vector<NavSample>& nav,

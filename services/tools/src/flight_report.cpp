@@ -21,6 +21,7 @@
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
+#include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
 #include "ofn/scan_world_t.hpp"
 #include "ofn/solver_stats_t.hpp"
@@ -116,6 +117,9 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   std::vector<double> solve_times;
   std::map<int, int> solver_status_count;
   std::vector<TimeSpan> recovery;
+  // Scan-to-plan latency: every map's stamp, and every step that planned.
+  std::vector<double> map_stamps;
+  std::vector<PlanStep> plan_steps;
   auto row = [](std::ofstream& f, std::initializer_list<Vec3> vs) {
     for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
   };
@@ -203,6 +207,10 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
         ++solver_status_count[m.status];
         solve_times.push_back(m.solve_time);
       }
+      // Steps that published a trajectory (a deferral leaves guidance on).
+      if (m.status != solver_stats_t::NOT_RUN && m.status != solver_stats_t::DEFERRED &&
+          m.map_utime > 0)
+        plan_steps.push_back({rel(m.utime), rel(m.map_utime)});
       // The dead-end recovery's steps, joined into spans (the optimiser
       // reports at 5-20 Hz; a gap of a second ends a span).
       const bool recovering = m.status == solver_stats_t::LOOKING_AROUND ||
@@ -215,6 +223,10 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
         else
           recovery.push_back({t, t});
       }
+    } else if (channel == channels::kObstacleGrid) {
+      obstacle_grid_t m{};
+      if (!decode(e, m)) return false;
+      map_stamps.push_back(rel(m.utime));
     } else if (channel == channels::kMission) {
       mission_t m{};
       if (!decode(e, m)) return false;
@@ -253,6 +265,11 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   }
   // Bad input (exit code 2), like an unreadable log.
   if (nav.empty()) throw std::invalid_argument(log_path + ": no NAV_STATE messages in the log");
+  // A multi-process log holds messages in arrival order.
+  std::sort(map_stamps.begin(), map_stamps.end());
+  std::sort(plan_steps.begin(), plan_steps.end(),
+            [](const PlanStep& a, const PlanStep& b) { return a.published < b.published; });
+  const std::vector<double> scan_to_plan = scan_to_plan_latencies(map_stamps, plan_steps);
 
   Limits limits;
   if (mission) {
@@ -344,6 +361,10 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
        << "  \"rh_looking_around\": " << solver_status_count[solver_stats_t::LOOKING_AROUND]
        << ",\n"
        << "  \"rh_no_route\": " << solver_status_count[solver_stats_t::NO_ROUTE] << ",\n"
+       << "  \"scan_to_plan_scans\": " << scan_to_plan.size() << ",\n"
+       << "  \"scan_to_plan_median\": " << json_number(percentile(scan_to_plan, 0.5)) << ",\n"
+       << "  \"scan_to_plan_p99\": " << json_number(percentile(scan_to_plan, 0.99)) << ",\n"
+       << "  \"scan_to_plan_max\": " << json_number(percentile(scan_to_plan, 1.0)) << ",\n"
        << "  \"recovery_time\": " << s.recovery_time << ",\n"
        << "  \"outcome\": \"" << to_string(result.verdict.outcome) << "\",\n"
        << "  \"success\": " << (result.verdict.success ? "true" : "false") << ",\n"
@@ -434,6 +455,13 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   } else {
     t << "  RH optimiser      : never engaged (nominal waypoint guidance throughout)\n";
   }
+  if (!scan_to_plan.empty())
+    t << "  scan to plan      : median " << std::setprecision(0)
+      << 1e3 * *percentile(scan_to_plan, 0.5) << " ms, p99 "
+      << 1e3 * *percentile(scan_to_plan, 0.99) << " ms, max "
+      << 1e3 * *percentile(scan_to_plan, 1.0) << " ms over " << scan_to_plan.size()
+      << " scans while avoiding (a scan's stamp to the first RH step on a map holding it)\n"
+      << std::setprecision(2);
   if (path_seq > 0) t << "  global planner    : " << path_seq << " paths published\n";
   if (result.undecodable)
     t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";

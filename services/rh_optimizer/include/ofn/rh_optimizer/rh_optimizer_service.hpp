@@ -148,6 +148,8 @@ class RhOptimizerService {
   mapping::DistanceField field_;
   bool field_valid_ = false;
   Utime field_built_ = INT64_MIN;
+  // The stamp of the grid the field was built from (SOLVER_STATS.map_utime).
+  Utime field_map_utime_ = 0;
   double field_altitude_ = 0;  // vehicle altitude the field's band is centred on
   std::vector<Vec3> route_;    // global path in use as the cold-start guess
   // What the global planner said last, and the points of its route (any

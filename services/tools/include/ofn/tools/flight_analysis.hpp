@@ -152,4 +152,22 @@ FlightSummary analyse_flight(const std::vector<NavSample>& nav,
                              std::optional<double> start_gate, std::optional<double> finish_gate,
                              const std::vector<TimeSpan>& recovery = {});
 
+/// One step of the RH optimiser that published a trajectory: when, and the
+/// stamp of the map it planned on (SOLVER_STATS.map_utime), both in s of
+/// the flight's clock.
+struct PlanStep {
+  double published = 0;
+  double map = 0;
+};
+
+/// Scan-to-plan latency, s: for each map stamp (an OBSTACLE_GRID's, the
+/// newest scan in it) taken while the optimiser was planning (a step
+/// published at most `active_gap` before it), the time from the stamp to
+/// the first step published on a map at least that new. A stamp that no
+/// step planned on before a pause in planning longer than `active_gap` is
+/// left out. `steps` in publication order.
+std::vector<double> scan_to_plan_latencies(const std::vector<double>& map_stamps,
+                                           const std::vector<PlanStep>& steps,
+                                           double active_gap = 0.5);
+
 }  // namespace ofn::report
