@@ -7,7 +7,10 @@ Run from the repository root:
     /usr/bin/python3 -m unittest tests/integration/test_launcher_table.py
 """
 
+import csv
+import glob
 import importlib.util
+import json
 import os
 import re
 import signal
@@ -571,6 +574,61 @@ class SupervisionTest(LauncherTestCase):
                                    "--timeout", "60")
         self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
         self.assertNotIn("restart count reset", result.stdout)
+
+    def test_memory_and_cpu_of_each_service_are_sampled(self):
+        # One service that grows by 8 MB every 0.3 s and burns CPU, and one
+        # that sleeps: resources.csv has both once a second, and the summary
+        # shows the first one's growth and the second one's idleness.
+        grower = ("import time\n"
+                  "blocks = []\n"
+                  "end = time.monotonic() + 3.2\n"
+                  "while time.monotonic() < end:\n"
+                  "    blocks.append(bytearray(8 * 1024 * 1024))\n"
+                  "    stop = time.monotonic() + 0.3\n"
+                  "    while time.monotonic() < stop:\n"
+                  "        pass\n")
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: sleeper
+                host: gcs
+                core: 0
+                command: ["sleep", "60"]
+              - name: grower
+                host: gcs
+                core: 0
+                command: ["%s", "-c", %s]
+                ends_run: true
+            """ % (sys.executable, json.dumps(grower)))
+        result = self.run_launcher(table, "--timeout", "30")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        found = glob.glob(os.path.join(self.log_dir, "*", "resources.csv"))
+        self.assertEqual(len(found), 1, result.stdout)
+        with open(found[0]) as f:
+            rows = list(csv.DictReader(f))
+        by_service = {}
+        for row in rows:
+            by_service.setdefault(row["service"], []).append(row)
+        self.assertEqual(set(by_service), {"sleeper", "grower"})
+        grown = [float(r["rss_mb"]) for r in by_service["grower"]]
+        self.assertGreaterEqual(len(grown), 3)
+        self.assertGreater(grown[-1] - grown[0], 40.0, grown)
+        grower_cpu = [float(r["cpu_s"]) for r in by_service["grower"]]
+        self.assertGreater(grower_cpu[-1] - grower_cpu[0], 1.0, grower_cpu)
+        sleeper_cpu = [float(r["cpu_s"]) for r in by_service["sleeper"]]
+        self.assertLess(sleeper_cpu[-1] - sleeper_cpu[0], 0.1, sleeper_cpu)
+        self.assertRegex(result.stdout, r"grower .*; rss \d+\.\d MB \(peak \d+\.\d\), cpu \d+ %")
+        self.assertRegex(result.stdout, r"sleeper .*; rss \d+\.\d MB \(peak \d+\.\d\), cpu 0 %")
+        self.assertIn("resources.csv", result.stdout)
+
+    def test_proc_resources_of_a_process_that_is_gone(self):
+        proc = subprocess.Popen(["true"])
+        proc.wait()
+        self.assertIsNone(launch.read_proc_resources(proc.pid))
+        rss, cpu_s = launch.read_proc_resources(os.getpid())
+        self.assertGreater(rss, 1e6)
+        self.assertGreaterEqual(cpu_s, 0.0)
 
     def assert_process_gone(self, pid_file):
         with open(pid_file) as f:
