@@ -6,8 +6,8 @@
 
 #include "ofn/controller/neural_adaptation.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
+#include "ofn/rotorcraft_model/rotorcraft_model.hpp"
 #include "ofn/vehicle_sim/disturbances.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
 
 namespace {
 

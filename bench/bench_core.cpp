@@ -6,14 +6,15 @@
 
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/rotorcraft_model/rotorcraft_model.hpp"
+#include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
 
 namespace {
 
 using ofn::Vec3;
 
 void BM_DynamicsStep(benchmark::State& state) {
-  ofn::vehicle::RotorcraftModel model;
+  ofn::vehicle::RotorcraftSimulation model;
   const auto trim = ofn::vehicle::trim(model, Vec3(3.0, 0, 0), 0.0);
   model.set_state(trim.state);
   model.set_command(trim.controls);

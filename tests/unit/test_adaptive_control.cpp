@@ -16,7 +16,7 @@
 #include "ofn/controller/tracking_flight.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/vehicle_sim/disturbances.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
 
 namespace ofn::control {
 namespace {
@@ -163,7 +163,7 @@ struct SaturationRun {
 
 SaturationRun fly_saturation(bool hedging) {
   const RotorcraftParams nominal;
-  vehicle::RotorcraftModel model(nominal);
+  vehicle::RotorcraftSimulation model(nominal);
   const auto trim = vehicle::trim(model, Vec3::Zero(), 0.0);
   model.set_state(trim.state);
   model.set_command(trim.controls);

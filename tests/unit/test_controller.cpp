@@ -13,7 +13,8 @@
 
 #include "ofn/common/braking.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/rotorcraft_model/rotorcraft_model.hpp"
+#include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
 
 namespace ofn::control {
 namespace {
@@ -21,6 +22,7 @@ namespace {
 using vehicle::Controls;
 using vehicle::RotorcraftModel;
 using vehicle::RotorcraftParams;
+using vehicle::RotorcraftSimulation;
 
 constexpr double kControlDt = 0.01;    // 100 Hz control loop
 constexpr int kPhysicsPerControl = 4;  // 400 Hz physics
@@ -67,7 +69,7 @@ class ClosedLoop {
   }
 
   const vehicle::RotorcraftState& state() const { return model_.state(); }
-  const RotorcraftModel& model() const { return model_; }
+  const RotorcraftSimulation& model() const { return model_; }
   /// Changes the vehicle's velocity by `dv` (world), as a push the
   /// controller is not told of.
   void push(const Vec3& dv) {
@@ -77,7 +79,7 @@ class ClosedLoop {
   }
 
  private:
-  RotorcraftModel model_;
+  RotorcraftSimulation model_;
   TrajectoryController controller_;
 };
 

@@ -1,10 +1,12 @@
-// The 6-DOF rotorcraft model: trim, equilibrium, control sense and limits.
+// The 6-DOF rotorcraft model and its simulation: trim, equilibrium, control
+// sense and limits.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/rotorcraft_model/rotorcraft_model.hpp"
+#include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
 
 namespace ofn::vehicle {
 namespace {
@@ -12,14 +14,14 @@ namespace {
 constexpr double kDt = 1.0 / 400.0;  // the simulation's physics step
 
 /// Steps `model` for `seconds` at 400 Hz.
-void fly(RotorcraftModel& model, double seconds) {
+void fly(RotorcraftSimulation& model, double seconds) {
   const int steps = static_cast<int>(std::lround(seconds / kDt));
   for (int i = 0; i < steps; ++i) model.step(kDt);
 }
 
 /// A model at hover trim, commanded with the trim controls.
-RotorcraftModel hovering(TrimResult* trim_out = nullptr) {
-  RotorcraftModel model;
+RotorcraftSimulation hovering(TrimResult* trim_out = nullptr) {
+  RotorcraftSimulation model;
   const TrimResult t = trim(model, Vec3::Zero(), 0.0);
   model.set_state(t.state);
   model.set_command(t.controls);
@@ -32,7 +34,7 @@ double angle_between(const Quat& a, const Quat& b) {
 }
 
 TEST(RotorcraftModel, HoverTrimConvergesToAnEquilibrium) {
-  RotorcraftModel model;
+  RotorcraftSimulation model;
   const TrimResult t = trim(model, Vec3::Zero(), 0.0);
   ASSERT_TRUE(t.converged) << "residual " << t.residual;
   EXPECT_LT(t.residual, 1e-6);
@@ -49,7 +51,7 @@ TEST(RotorcraftModel, HoverTrimConvergesToAnEquilibrium) {
 
 TEST(RotorcraftModel, HoverTrimThrustCarriesTheWeight) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   model.step(kDt);
   const auto& p = model.params();
   // Level hover: thrust equals weight to well within a percent.
@@ -62,7 +64,7 @@ TEST(RotorcraftModel, HoverTrimThrustCarriesTheWeight) {
 }
 
 TEST(RotorcraftModel, ForwardFlightTrimConvergesAndHolds) {
-  RotorcraftModel model;
+  RotorcraftSimulation model;
   const Vec3 velocity(3.048, 0.0, 0.0);  // 10 ft/s, the benchmark cruise speed
   const TrimResult t = trim(model, velocity, 0.0);
   ASSERT_TRUE(t.converged) << "residual " << t.residual;
@@ -78,7 +80,7 @@ TEST(RotorcraftModel, ForwardFlightTrimConvergesAndHolds) {
 }
 
 TEST(RotorcraftModel, ForwardFlightTrimHoldsAtAnotherHeading) {
-  RotorcraftModel model;
+  RotorcraftSimulation model;
   const double yaw = deg2rad(60);
   const Vec3 velocity = 3.048 * Vec3(std::cos(yaw), std::sin(yaw), 0.0);
   const TrimResult t = trim(model, velocity, yaw);
@@ -91,7 +93,7 @@ TEST(RotorcraftModel, ForwardFlightTrimHoldsAtAnotherHeading) {
 }
 
 TEST(RotorcraftModel, TrimControlsLieWithinActuatorLimits) {
-  RotorcraftModel model;
+  const RotorcraftModel model;
   const auto& p = model.params();
   for (const Vec3& v : {Vec3(0, 0, 0), Vec3(3.048, 0, 0), Vec3(6.0, 0, 0)}) {
     const TrimResult t = trim(model, v, 0.0);
@@ -123,7 +125,7 @@ TEST(RotorcraftModel, MoreCollectiveGivesMoreThrust) {
 
 TEST(RotorcraftModel, ExtraCollectiveFromHoverClimbs) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   Controls c = t.controls;
   c.collective += 0.03;
   model.set_command(c);
@@ -136,7 +138,7 @@ TEST(RotorcraftModel, ExtraCollectiveFromHoverClimbs) {
 
 TEST(RotorcraftModel, LessCollectiveFromHoverDescends) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   Controls c = t.controls;
   c.collective -= 0.03;
   model.set_command(c);
@@ -146,7 +148,7 @@ TEST(RotorcraftModel, LessCollectiveFromHoverDescends) {
 
 TEST(RotorcraftModel, ForwardCyclicPitchesNoseDownAndAcceleratesNorth) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   Controls c = t.controls;
   c.lon_cyclic += 0.03;
   model.set_command(c);
@@ -161,7 +163,7 @@ TEST(RotorcraftModel, ForwardCyclicPitchesNoseDownAndAcceleratesNorth) {
 
 TEST(RotorcraftModel, AftCyclicPitchesNoseUp) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   Controls c = t.controls;
   c.lon_cyclic -= 0.03;
   model.set_command(c);
@@ -173,7 +175,7 @@ TEST(RotorcraftModel, AftCyclicPitchesNoseUp) {
 
 TEST(RotorcraftModel, RightCyclicRollsRight) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   Controls c = t.controls;
   c.lat_cyclic += 0.03;
   model.set_command(c);
@@ -186,7 +188,7 @@ TEST(RotorcraftModel, RightCyclicRollsRight) {
 
 TEST(RotorcraftModel, RightPedalYawsNoseRight) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   Controls c = t.controls;
   c.pedal += 0.05;
   model.set_command(c);
@@ -194,7 +196,7 @@ TEST(RotorcraftModel, RightPedalYawsNoseRight) {
   EXPECT_GT(model.state().body_rates.z(), 0.0) << "yaw rate r";
   EXPECT_GT(euler_from_quat(model.state().attitude).z(), 0.0);
 
-  RotorcraftModel left = hovering();
+  RotorcraftSimulation left = hovering();
   c = t.controls;
   c.pedal -= 0.05;
   left.set_command(c);
@@ -203,7 +205,7 @@ TEST(RotorcraftModel, RightPedalYawsNoseRight) {
 }
 
 TEST(RotorcraftModel, CommandBeyondLimitsIsClamped) {
-  RotorcraftModel model;
+  RotorcraftSimulation model;
   const auto& p = model.params();
   model.set_command({1.0, 1.0, -1.0, 5.0});
   EXPECT_DOUBLE_EQ(model.command().collective, p.max_controls.collective);
@@ -225,7 +227,7 @@ TEST(RotorcraftModel, CommandBeyondLimitsIsClamped) {
 
 TEST(RotorcraftModel, ActuatorsNeverLeaveTheirLimits) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   const auto& p = model.params();
   model.set_command({10.0, -10.0, 10.0, -10.0});
   for (int i = 0; i < 200; ++i) {
@@ -243,7 +245,7 @@ TEST(RotorcraftModel, ActuatorsNeverLeaveTheirLimits) {
 
 TEST(RotorcraftModel, ServoRateLimitBoundsActuatorMotion) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   const auto& p = model.params();
   Controls c = t.controls;
   c.lon_cyclic = p.max_controls.lon_cyclic;
@@ -274,7 +276,7 @@ TEST(RotorcraftModel, SteadyHoverInflowMatchesMomentumTheory) {
 
 TEST(RotorcraftModel, InflowSettlesToItsSteadyValue) {
   TrimResult t;
-  RotorcraftModel model = hovering(&t);
+  RotorcraftSimulation model = hovering(&t);
   RotorcraftState s = model.state();
   s.induced_velocity = 0.0;  // inflow not yet built up
   model.set_state(s);

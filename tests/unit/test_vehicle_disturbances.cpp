@@ -166,7 +166,7 @@ TEST(VehicleVariation, ScalesTheAirframeAndSetsActuatorAuthority) {
   EXPECT_DOUBLE_EQ(p.actuator_rate.collective, 0.5);
   EXPECT_DOUBLE_EQ(p.actuator_rate.pedal, base.actuator_rate.pedal);
   // The model honours the narrower authority.
-  RotorcraftModel m(p);
+  RotorcraftSimulation m(p);
   m.set_command({0.1, 1.0, -1.0, 0.0});
   EXPECT_DOUBLE_EQ(m.command().lon_cyclic, deg2rad(5.0));
   EXPECT_DOUBLE_EQ(m.command().lat_cyclic, -deg2rad(5.0));

@@ -260,7 +260,8 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   probe.actuators.collective = out.controls.collective;
   probe.induced_velocity = model_.steady_induced_velocity(out.controls.collective, air_body);
   vehicle::RotorcraftLoads loads;
-  model_.derivative(probe, probe.actuators, &loads);
+  // No wind: the controller knows only the velocity over the ground.
+  model_.derivative(probe, probe.actuators, Vec3::Zero(), &loads);
   const double tail_thrust = (loads.rotor_torque - moment.z()) / p.tail_arm;
   // Carried to the next step; one bad input must not poison the ones after.
   if (std::isfinite(tail_thrust)) tail_thrust_estimate_ = tail_thrust;

@@ -12,7 +12,7 @@
 #include "ofn/controller/neural_adaptation.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/rotorcraft_model/rotorcraft_model.hpp"
 
 namespace ofn::control {
 

@@ -19,7 +19,7 @@
 #include <memory>
 
 #include "ofn/common/frames.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/rotorcraft_model/rotorcraft_model.hpp"
 
 namespace ofn::control {
 

@@ -11,7 +11,7 @@
 
 #include "ofn/common/frames.hpp"
 #include "ofn/common/scenario.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
 
 namespace ofn::vehicle {
 
@@ -95,7 +95,7 @@ class SimulatedVehicle {
   /// Each call draws fresh noise.
   NavSample measure();
 
-  const RotorcraftModel& model() const { return model_; }
+  const RotorcraftSimulation& model() const { return model_; }
   double time() const { return time_; }
   /// Air-mass velocity now (steady wind + gust), world NED.
   Vec3 wind() const { return steady_wind_ + gust_ned_; }
@@ -105,7 +105,7 @@ class SimulatedVehicle {
  private:
   void record();
 
-  RotorcraftModel model_;
+  RotorcraftSimulation model_;
   Vec3 steady_wind_;
   Disturbances disturbances_;
   double ground_altitude_;

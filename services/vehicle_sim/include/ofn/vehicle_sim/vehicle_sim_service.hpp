@@ -12,7 +12,7 @@
 #include "ofn/common/scenario.hpp"
 #include "ofn/vehicle_sim/disturbances.hpp"
 #include "ofn/vehicle_sim/lidar_head.hpp"
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
 #include "ofn/virtual_obstacles_t.hpp"
 #include "ofn/world/world.hpp"
 
@@ -41,7 +41,7 @@ class VehicleSimService {
                     VehicleSimConfig config, double real_time_factor = 1.0);
 
   Node& node() { return node_; }
-  const RotorcraftModel& model() const { return vehicle_.model(); }
+  const RotorcraftSimulation& model() const { return vehicle_.model(); }
   const SimulatedVehicle& vehicle() const { return vehicle_; }
   bool released() const { return released_; }
   const world::World& world() const { return world_; }

@@ -1,4 +1,4 @@
-#include "ofn/vehicle_sim/rotorcraft_model.hpp"
+#include "ofn/rotorcraft_model/rotorcraft_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,6 @@
 #include <Eigen/Dense>
 
 namespace ofn::vehicle {
-namespace {
 
 Controls clamp_controls(const Controls& c, const RotorcraftParams& p) {
   auto lim = [](double v, double lo, double hi) { return std::clamp(v, lo, hi); };
@@ -15,26 +14,6 @@ Controls clamp_controls(const Controls& c, const RotorcraftParams& p) {
           lim(c.lat_cyclic, p.min_controls.lat_cyclic, p.max_controls.lat_cyclic),
           lim(c.pedal, p.min_controls.pedal, p.max_controls.pedal)};
 }
-
-/// s + h * d, the Runge-Kutta stage state.
-RotorcraftState advance(const RotorcraftState& s, const RotorcraftDerivative& d, double h) {
-  RotorcraftState out = s;
-  out.position += h * d.position_dot;
-  out.velocity += h * d.velocity_dot;
-  out.body_rates += h * d.rates_dot;
-  Eigen::Vector4d q(s.attitude.w(), s.attitude.x(), s.attitude.y(), s.attitude.z());
-  q += h * d.attitude_dot;
-  out.attitude = Quat(q[0], q[1], q[2], q[3]).normalized();
-  out.flap_lon += h * d.flap_lon_dot;
-  out.flap_lat += h * d.flap_lat_dot;
-  out.induced_velocity += h * d.inflow_dot;
-  auto a = s.actuators.as_array();
-  for (int i = 0; i < 4; ++i) a[i] += h * d.actuator_dot[i];
-  out.actuators = Controls::from_array(a);
-  return out;
-}
-
-}  // namespace
 
 std::optional<std::string> controls_beyond_limits(const Controls& command,
                                                   const RotorcraftParams& params,
@@ -51,10 +30,6 @@ std::optional<std::string> controls_beyond_limits(const Controls& command,
 }
 
 RotorcraftModel::RotorcraftModel(RotorcraftParams params) : params_(std::move(params)) {}
-
-void RotorcraftModel::set_command(const Controls& command) {
-  command_ = clamp_controls(command, params_);
-}
 
 double RotorcraftModel::thrust(double collective, double induced_velocity,
                                const Vec3& air_body) const {
@@ -88,10 +63,11 @@ double RotorcraftModel::steady_induced_velocity(double collective, const Vec3& a
 }
 
 RotorcraftDerivative RotorcraftModel::derivative(const RotorcraftState& s, const Controls& command,
+                                                 const Vec3& wind,
                                                  RotorcraftLoads* loads_out) const {
   const auto& p = params_;
   const Mat3 world_from_body = s.attitude.toRotationMatrix();
-  const Vec3 air_body = world_from_body.transpose() * (s.velocity - wind_);
+  const Vec3 air_body = world_from_body.transpose() * (s.velocity - wind);
   const Vec3& w = s.body_rates;
   const Controls& act = s.actuators;
   RotorcraftDerivative d;
@@ -150,31 +126,7 @@ RotorcraftDerivative RotorcraftModel::derivative(const RotorcraftState& s, const
   return d;
 }
 
-void RotorcraftModel::step(double dt) {
-  const RotorcraftState& s = state_;
-  const auto k1 = derivative(s, command_, &loads_);
-  const auto k2 = derivative(advance(s, k1, 0.5 * dt), command_);
-  const auto k3 = derivative(advance(s, k2, 0.5 * dt), command_);
-  const auto k4 = derivative(advance(s, k3, dt), command_);
-  RotorcraftDerivative sum = k1;
-  auto combine = [](auto a, auto b, auto c, auto d) { return (a + 2.0 * b + 2.0 * c + d) / 6.0; };
-  sum.position_dot = combine(k1.position_dot, k2.position_dot, k3.position_dot, k4.position_dot);
-  sum.velocity_dot = combine(k1.velocity_dot, k2.velocity_dot, k3.velocity_dot, k4.velocity_dot);
-  sum.rates_dot = combine(k1.rates_dot, k2.rates_dot, k3.rates_dot, k4.rates_dot);
-  sum.attitude_dot = combine(k1.attitude_dot, k2.attitude_dot, k3.attitude_dot, k4.attitude_dot);
-  sum.flap_lon_dot = combine(k1.flap_lon_dot, k2.flap_lon_dot, k3.flap_lon_dot, k4.flap_lon_dot);
-  sum.flap_lat_dot = combine(k1.flap_lat_dot, k2.flap_lat_dot, k3.flap_lat_dot, k4.flap_lat_dot);
-  sum.inflow_dot = combine(k1.inflow_dot, k2.inflow_dot, k3.inflow_dot, k4.inflow_dot);
-  for (int i = 0; i < 4; ++i)
-    sum.actuator_dot[i] =
-        combine(k1.actuator_dot[i], k2.actuator_dot[i], k3.actuator_dot[i], k4.actuator_dot[i]);
-  state_ = advance(s, sum, dt);
-  acceleration_ = sum.velocity_dot;
-}
-
 TrimResult trim(const RotorcraftModel& model, const Vec3& velocity, double yaw, const Vec3& wind) {
-  RotorcraftModel m = model;
-  m.set_wind(wind);
   const auto& p = model.params();
   // Unknowns: collective, lon cyclic, lat cyclic, pedal, roll, pitch.
   using Vec6 = Eigen::Matrix<double, 6, 1>;
@@ -186,12 +138,12 @@ TrimResult trim(const RotorcraftModel& model, const Vec3& velocity, double yaw, 
     const Vec3 air_body = s.attitude.toRotationMatrix().transpose() * (velocity - wind);
     s.flap_lon = p.cyclic_to_flap * x[1] - p.flap_blowback * air_body.x();
     s.flap_lat = p.cyclic_to_flap * x[2] - p.flap_blowback * air_body.y();
-    s.induced_velocity = m.steady_induced_velocity(x[0], air_body);
+    s.induced_velocity = model.steady_induced_velocity(x[0], air_body);
     return s;
   };
   auto residual = [&](const Vec6& x) {
     const RotorcraftState s = build(x);
-    const auto d = m.derivative(s, s.actuators);
+    const auto d = model.derivative(s, s.actuators, wind);
     Vec6 r;
     r << d.velocity_dot, d.rates_dot;
     return r;

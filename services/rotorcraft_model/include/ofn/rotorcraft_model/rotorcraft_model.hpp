@@ -1,6 +1,10 @@
 #pragma once
-// 6-DOF rigid-body model of a Yamaha RMAX-class helicopter. Pure core: no
-// LCM, no clock; step() advances the state by a fixed time step.
+// 6-DOF rigid-body model of a Yamaha RMAX-class helicopter: its parameters,
+// state and equations of motion. Pure core: no LCM, no clock, and no state
+// of its own: derivative() gives the rate of change of a state under a
+// command and a wind. The simulator integrates it as the truth
+// (RotorcraftSimulation, vehicle_sim); the controller inverts it as its
+// nominal model of the airframe, with its own parameters.
 //
 // Components: main-rotor thrust from collective by blade-element theory with
 // a momentum-theory inflow that lags (first order); first-order
@@ -101,6 +105,9 @@ struct RotorcraftDerivative {
   std::array<double, 4> actuator_dot{};
 };
 
+/// The command within the actuators' position limits.
+Controls clamp_controls(const Controls& command, const RotorcraftParams& params);
+
 /// Which actuator a command drives beyond its position limits (by more than
 /// `tolerance`, rad), or nullopt: the simulator refuses such a command
 /// rather than quietly clamp what no healthy controller sends.
@@ -108,28 +115,18 @@ std::optional<std::string> controls_beyond_limits(const Controls& command,
                                                   const RotorcraftParams& params,
                                                   double tolerance = 1e-6);
 
+/// The equations of motion for one set of parameters.
 class RotorcraftModel {
  public:
   explicit RotorcraftModel(RotorcraftParams params = {});
 
   const RotorcraftParams& params() const { return params_; }
-  const RotorcraftState& state() const { return state_; }
-  void set_state(const RotorcraftState& s) { state_ = s; }
-  /// Kinematic acceleration (NED) at the last step.
-  const Vec3& acceleration() const { return acceleration_; }
-  const RotorcraftLoads& loads() const { return loads_; }
 
-  /// Commanded controls are clamped to the position limits here.
-  void set_command(const Controls& command);
-  const Controls& command() const { return command_; }
-  void set_wind(const Vec3& wind_ned) { wind_ = wind_ned; }
-
-  /// Advances by dt with fourth-order Runge-Kutta.
-  void step(double dt);
-
-  /// Derivative of a state under a command and wind; also returns the loads.
+  /// Derivative of a state under a command (clamped to the position limits
+  /// before the servos follow it) and the air mass's velocity `wind` (NED);
+  /// also returns the loads.
   RotorcraftDerivative derivative(const RotorcraftState& s, const Controls& command,
-                                  RotorcraftLoads* loads = nullptr) const;
+                                  const Vec3& wind, RotorcraftLoads* loads = nullptr) const;
 
   /// Main-rotor thrust and the matching steady induced velocity for a
   /// collective and the air velocity in body axes (used by trim and by the
@@ -139,11 +136,6 @@ class RotorcraftModel {
 
  private:
   RotorcraftParams params_;
-  RotorcraftState state_;
-  Controls command_;
-  Vec3 wind_ = Vec3::Zero();
-  Vec3 acceleration_ = Vec3::Zero();
-  RotorcraftLoads loads_;
 };
 
 /// Result of a trim search.
