@@ -17,7 +17,7 @@
 #include "ofn/common/config.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/controller/controller_service.hpp"
-#include "ofn/controller/tracking_flight.hpp"
+#include "ofn/sim/tracking_flight.hpp"
 
 namespace {
 
@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   ofn::Scenario base;
-  ofn::control::TrackingSetup tuned;
+  ofn::sim::TrackingSetup tuned;
   try {
     base = ofn::load_scenario(scenario_path);
     auto reader = ofn::YamlReader::load_file(config_path);
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
      << "| mass | inertia / time constants | wind | adaptive RMS | adaptive max | "
         "non-adaptive RMS | non-adaptive max | RMS change |\n"
      << "|---|---|---|---|---|---|---|---|\n";
-  ofn::control::TrackingFlightConfig config;
+  ofn::sim::TrackingFlightConfig config;
   config.duration = duration;
   for (const auto& airframe : airframes)
     for (double mass : mass_scales)
@@ -99,10 +99,10 @@ int main(int argc, char** argv) {
         s.vehicle.actuator_time_scale = airframe.time_scale;
         s.wind = ofn::Vec3(0, wind * kt, 0);  // across the northbound course
         s.disturbances.turbulence.wind_at_20ft = w20;
-        ofn::control::TrackingSetup adaptive = tuned, baseline = tuned;
+        ofn::sim::TrackingSetup adaptive = tuned, baseline = tuned;
         baseline.adaptive.enabled = false;
-        const auto a = ofn::control::fly_tracking(s, adaptive, config);
-        const auto b = ofn::control::fly_tracking(s, baseline, config);
+        const auto a = ofn::sim::fly_tracking(s, adaptive, config);
+        const auto b = ofn::sim::fly_tracking(s, baseline, config);
         auto fmt = [](double v) {
           char buf[32];
           std::snprintf(buf, sizeof buf, v < 100 ? "%.2f" : "%.0f", v);

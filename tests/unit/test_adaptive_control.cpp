@@ -13,14 +13,18 @@
 
 #include "ofn/common/scenario.hpp"
 #include "ofn/controller/neural_adaptation.hpp"
-#include "ofn/controller/tracking_flight.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
+#include "ofn/sim/tracking_flight.hpp"
 #include "ofn/vehicle_sim/disturbances.hpp"
 #include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
 
 namespace ofn::control {
 namespace {
 
+using sim::fly_tracking;
+using sim::TrackingFlightConfig;
+using sim::TrackingResult;
+using sim::TrackingSetup;
 using vehicle::Controls;
 using vehicle::RotorcraftParams;
 

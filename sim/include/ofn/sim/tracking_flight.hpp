@@ -3,7 +3,10 @@
 // wind, turbulence, navigation errors from the scenario) and the trajectory
 // follower stepped together under waypoint guidance, with no bus. Measures
 // how well the vehicle follows the commanded trajectory; used by the
-// adaptive-control tests, benchmarks and the tracking sweep.
+// adaptive-control tests, benchmarks and the tracking sweep. Pure core: no
+// LCM, no clock. It gives the follower its reference and heading as the
+// controller service does in waypoint mode, without the service's other
+// modes, command gate, speed governor or held adaptation.
 
 #include <vector>
 
@@ -14,7 +17,7 @@
 #include "ofn/controller/waypoint_guidance.hpp"
 #include "ofn/rotorcraft_model/rotorcraft_model.hpp"
 
-namespace ofn::control {
+namespace ofn::sim {
 
 struct TrackingFlightConfig {
   double duration = 600;      // s of flight
@@ -42,14 +45,14 @@ struct TrackingResult {
 struct TrackingSetup {
   vehicle::RotorcraftParams nominal;  // the controller's model; the flown airframe is this
                                       // changed by the scenario's `vehicle:` section
-  ControllerGains gains;
-  AdaptiveConfig adaptive;
-  GuidanceConfig guidance;
+  control::ControllerGains gains;
+  control::AdaptiveConfig adaptive;
+  control::GuidanceConfig guidance;
   // The heading as the controller service commands it: along the leg at a
   // bounded turn rate (a route flown back turns it through 180 deg), with
   // the yaw sweep over it.
-  PathHeading heading;
-  YawSweep sweep;
+  control::PathHeading heading;
+  control::YawSweep sweep;
   /// Of the scenario's acceleration limit: the stop whose distance the sweep
   /// covers (the controller's reference_selector.stop_accel_fraction).
   double stop_accel_fraction = 0.8;
@@ -63,4 +66,4 @@ struct TrackingSetup {
 TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup,
                             const TrackingFlightConfig& config = {});
 
-}  // namespace ofn::control
+}  // namespace ofn::sim

@@ -1,12 +1,26 @@
-#include "ofn/controller/tracking_flight.hpp"
+#include "ofn/sim/tracking_flight.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "ofn/vehicle_sim/disturbances.hpp"
 
-namespace ofn::control {
+namespace ofn::sim {
 namespace {
+
+using control::ControlOutput;
+using control::facing_along;
+using control::GuidanceReference;
+using control::kMinLegHorizontal;
+using control::make_adaptive_element;
+using control::PathHeadingFilter;
+using control::predict_estimate;
+using control::Reference;
+using control::SweepCoverage;
+using control::TrajectoryController;
+using control::VehicleEstimate;
+using control::WaypointGuidance;
+using control::YawSweepGenerator;
 
 bool within(const vehicle::Controls& c, const vehicle::RotorcraftParams& p) {
   const auto v = c.as_array(), lo = p.min_controls.as_array(), hi = p.max_controls.as_array();
@@ -123,4 +137,4 @@ TrackingResult fly_tracking(const Scenario& scenario, const TrackingSetup& setup
   return r;
 }
 
-}  // namespace ofn::control
+}  // namespace ofn::sim
