@@ -5,9 +5,11 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/scenario.hpp"
@@ -281,6 +283,81 @@ TEST(ControllerConfig, DefaultsLoadFromAnEmptyReader) {
   const auto c = control::load_controller_config(reader);
   EXPECT_DOUBLE_EQ(c.rate, 100.0);
   EXPECT_TRUE(c.gains.position.isApprox(control::ControllerGains{}.position));
+}
+
+/// Every parameter of an airframe, in one list, to compare two bit for bit.
+std::vector<double> every_parameter(const vehicle::RotorcraftParams& p) {
+  std::vector<double> v = {
+      p.mass,           p.inertia.x(),         p.inertia.y(),           p.inertia.z(),
+      p.air_density,    p.rotor_radius,        p.rotor_speed,           p.lift_slope,
+      p.solidity,       p.profile_drag,        p.inflow_time_constant,  p.hub_height,
+      p.flap_stiffness, p.flap_time_constant,  p.cyclic_to_flap,        p.flap_blowback,
+      p.tail_arm,       p.tail_thrust_per_rad, p.tail_velocity_damping, p.drag_area.x(),
+      p.drag_area.y(),  p.drag_area.z(),       p.servo_time_constant};
+  for (const vehicle::Controls* c : {&p.min_controls, &p.max_controls, &p.actuator_rate})
+    for (double x : c->as_array()) v.push_back(x);
+  return v;
+}
+
+TEST(ControllerConfig, ShippedNominalAirframeIsTheShippedSimulatedOne) {
+  // The controller's model is exact until a scenario varies the airframe,
+  // as it was when the model was the simulator's own.
+  auto controller_reader =
+      YamlReader::load_file(std::string(OFN_SOURCE_DIR) + "/config/controller.yaml");
+  auto sim_reader = YamlReader::load_file(std::string(OFN_SOURCE_DIR) + "/config/vehicle_sim.yaml");
+  const auto nominal = control::load_controller_config(controller_reader).nominal;
+  const auto flown = vehicle::load_vehicle_sim_config(sim_reader).params;
+  EXPECT_EQ(every_parameter(nominal), every_parameter(flown));
+  EXPECT_EQ(every_parameter(nominal), every_parameter(vehicle::RotorcraftParams{}));
+  auto empty = YamlReader::empty("(defaults)");
+  EXPECT_EQ(every_parameter(control::load_controller_config(empty).nominal),
+            every_parameter(vehicle::RotorcraftParams{}));
+}
+
+TEST_F(ConfigFiles, ControllerConfigReadsTheNominalAirframe) {
+  const std::string path = write("controller.yaml",
+                                 "nominal_airframe:\n  mass: 90\n  rotor_radius: 1.6\n"
+                                 "  drag_area: [0.4, 1.2, 1.4]\n"
+                                 "  max_controls: [0.32, 0.15, 0.17, 0.45]\n");
+  auto reader = YamlReader::load_file(path);
+  const auto p = control::load_controller_config(reader).nominal;
+  const vehicle::RotorcraftParams base;
+  EXPECT_DOUBLE_EQ(p.mass, 90.0);
+  EXPECT_DOUBLE_EQ(p.rotor_radius, 1.6);
+  EXPECT_TRUE(p.drag_area.isApprox(Vec3(0.4, 1.2, 1.4)));
+  EXPECT_EQ(p.max_controls.as_array(), (std::array<double, 4>{0.32, 0.15, 0.17, 0.45}));
+  // Untouched parameters keep the simulated airframe's values.
+  EXPECT_EQ(p.min_controls.as_array(), base.min_controls.as_array());
+  EXPECT_EQ(p.tail_arm, base.tail_arm);
+}
+
+TEST_F(ConfigFiles, ControllerConfigBadNominalAirframeValueIsAnError) {
+  for (const std::string bad :
+       {"rotor_radius: 0", "cyclic_to_flap: -1", "inertia: [8, 0, 18]",
+        "actuator_rate: [1.5, 1.5, 1.5]", "min_controls: [-0.05, -0.16, -0.16, -2]"}) {
+    const std::string key = bad.substr(0, bad.find(':'));
+    const std::string path = write("controller.yaml", "nominal_airframe:\n  " + bad + "\n");
+    auto reader = YamlReader::load_file(path);
+    try {
+      control::load_controller_config(reader);
+      ADD_FAILURE() << "loaded " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NAMES(std::string(e.what()), path, "nominal_airframe." + key);
+    }
+  }
+}
+
+TEST_F(ConfigFiles, ControllerConfigControlLimitsOutOfOrderAreAnError) {
+  const std::string path = write("controller.yaml",
+                                 "nominal_airframe:\n  min_controls: [-0.05, -0.16, -0.16, -0.4]\n"
+                                 "  max_controls: [0.30, -0.2, 0.16, 0.4]\n");
+  auto reader = YamlReader::load_file(path);
+  try {
+    control::load_controller_config(reader);
+    FAIL() << "loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NAMES(std::string(e.what()), path, "nominal_airframe.max_controls");
+  }
 }
 
 TEST_F(ConfigFiles, VehicleSimNavRateAbovePhysicsRateIsAnError) {

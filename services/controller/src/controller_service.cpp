@@ -22,10 +22,55 @@ Vec3 vec(const std::vector<double>& a) {
 void put(double (&dst)[3], const Vec3& v) {
   for (int i = 0; i < 3; ++i) dst[i] = v[i];
 }
-// Gains per axis: three numbers, none negative.
-Vec3 read_vec3(YamlReader& r, const std::string& key, const Vec3& fallback) {
-  return vec(r.numbers_in(key, {fallback.x(), fallback.y(), fallback.z()}, 0.0,
-                          std::numeric_limits<double>::infinity()));
+// Gains per axis: three numbers, none negative (or each in [lo, hi]).
+Vec3 read_vec3(YamlReader& r, const std::string& key, const Vec3& fallback, double lo = 0.0,
+               double hi = std::numeric_limits<double>::infinity()) {
+  return vec(r.numbers_in(key, {fallback.x(), fallback.y(), fallback.z()}, lo, hi));
+}
+// Per channel: collective, longitudinal cyclic, lateral cyclic, pedal.
+vehicle::Controls read_controls(YamlReader& r, const std::string& key,
+                                const vehicle::Controls& fallback, double lo, double hi) {
+  const auto a = fallback.as_array();
+  const auto v = r.numbers_in(key, {a[0], a[1], a[2], a[3]}, lo, hi);
+  return vehicle::Controls::from_array({v[0], v[1], v[2], v[3]});
+}
+
+// Every parameter of the model is read below; a new one must be too, or
+// the controller would silently keep the simulator's value of it.
+static_assert(sizeof(vehicle::RotorcraftParams) == 35 * sizeof(double),
+              "a new RotorcraftParams field needs its nominal_airframe setting");
+
+// The controller's estimate of the airframe, the model it inverts. The
+// defaults are the simulator's airframe. Lower bounds keep every quantity
+// the inversion divides by away from zero.
+vehicle::RotorcraftParams read_nominal_airframe(YamlReader& r, vehicle::RotorcraftParams p) {
+  p.mass = r.number_in("mass", p.mass, 1.0, 1e4);
+  p.inertia = read_vec3(r, "inertia", p.inertia, 1e-3, 1e5);
+  p.air_density = r.number_in("air_density", p.air_density, 0.1, 2.0);
+  p.rotor_radius = r.number_in("rotor_radius", p.rotor_radius, 0.05, 20.0);
+  p.rotor_speed = r.number_in("rotor_speed", p.rotor_speed, 1.0, 5000.0);
+  p.lift_slope = r.number_in("lift_slope", p.lift_slope, 0.1, 10.0);
+  p.solidity = r.number_in("solidity", p.solidity, 0.001, 1.0);
+  p.profile_drag = r.number_in("profile_drag", p.profile_drag, 0.0, 0.1);
+  p.inflow_time_constant = r.number_in("inflow_time_constant", p.inflow_time_constant, 0.01, 2.0);
+  p.hub_height = r.number_in("hub_height", p.hub_height, 0.01, 10.0);
+  p.flap_stiffness = r.number_in("flap_stiffness", p.flap_stiffness, 0.0, 1e6);
+  p.flap_time_constant = r.number_in("flap_time_constant", p.flap_time_constant, 0.01, 2.0);
+  p.cyclic_to_flap = r.number_in("cyclic_to_flap", p.cyclic_to_flap, 0.05, 5.0);
+  p.flap_blowback = r.number_in("flap_blowback", p.flap_blowback, 0.0, 1.0);
+  p.tail_arm = r.number_in("tail_arm", p.tail_arm, 0.05, 20.0);
+  p.tail_thrust_per_rad = r.number_in("tail_thrust_per_rad", p.tail_thrust_per_rad, 1.0, 1e6);
+  p.tail_velocity_damping = r.number_in("tail_velocity_damping", p.tail_velocity_damping, 0.0, 1e4);
+  p.drag_area = read_vec3(r, "drag_area", p.drag_area, 0.0, 100.0);
+  p.min_controls = read_controls(r, "min_controls", p.min_controls, -1.5, 1.5);
+  p.max_controls = read_controls(r, "max_controls", p.max_controls, -1.5, 1.5);
+  const auto lo = p.min_controls.as_array(), hi = p.max_controls.as_array();
+  for (int i = 0; i < 4; ++i)
+    if (!(lo[i] < hi[i]))
+      r.fail("max_controls", "expected every limit above its min_controls counterpart");
+  p.actuator_rate = read_controls(r, "actuator_rate", p.actuator_rate, 0.01, 100.0);
+  p.servo_time_constant = r.number_in("servo_time_constant", p.servo_time_constant, 0.001, 1.0);
+  return p;
 }
 
 }  // namespace
@@ -156,7 +201,7 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.heading.look_ahead = heading.number_in("look_ahead", c.heading.look_ahead, 0.0, 20.0);
   heading.finish();
   YamlReader nominal = r.child("nominal_airframe");
-  c.nominal.mass = nominal.number_in("mass", c.nominal.mass, 1.0, 1e4);
+  c.nominal = read_nominal_airframe(nominal, c.nominal);
   nominal.finish();
   r.finish();
   return c;
