@@ -19,6 +19,7 @@
 #include "ofn/common/scenario.hpp"
 #include "ofn/mapper/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
+#include "ofn/rh_optimizer/rh_planner.hpp"
 #include "ofn/world/world.hpp"
 
 namespace {
@@ -205,5 +206,77 @@ BENCHMARK(BM_RhSolveWarmScreened)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RhSolveWarm)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RhSolveWarmMma)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+// A stop on the last waypoint in open space: from cruise speed 42 m short of
+// it, the planner steps every 0.1 s from where its own last plan has the
+// vehicle (as the service does) until the vehicle is at rest. With the
+// service's settings the first plan brakes on the acceleration reserve, and
+// most warm solves of the last three seconds find no feasible point (the
+// commanded-acceleration row, a + tau da/dt): the previous plan is kept and
+// flown, as it should be, but the solve's time is spent for nothing, and an
+// escape leg from a hover, which has no previous plan, has been seen to stop
+// there (docs/LIMITATIONS.md). Counters: steps, steps that kept the previous
+// plan, median and worst step time.
+void BM_RhStopAtTheLastWaypoint(benchmark::State& state) {
+  RhSettings settings;  // the service's (config/rh_optimizer.yaml)
+  settings.weights = Vec3(30.0, 30.0, 30.0);
+  settings.speed_margin = 0.005;
+  settings.accel_margin = 0.06;
+  settings.forward_speed_reserve = 0.15;
+  settings.clearance_margin = 0.5;
+  ofn::Limits limits;  // the benchmarks' (ft and ft/s^2 in SI)
+  limits.max_speed = 3.048;
+  limits.max_accel = 0.48768;
+  limits.max_vertical_speed = 1.524;
+  limits.min_forward_speed = 0.0;
+  limits.clearance = 6.096;
+  limits.sensor_range = 60.96;
+  const Vec3 leg_from(0, 0, -36.6), target(152.4, 0, -36.6);
+  int steps = 0, kept = 0;
+  std::vector<double> times;
+  for (auto _ : state) {
+    RhPlanner planner(settings);
+    Vec3 p(110.0, 0, -36.6), v(3.033, 0, 0), a = Vec3::Zero();
+    BsplineTrajectory flown;
+    double t = 0, flown_start = 0;
+    for (int k = 0; k < 600; ++k, t += kStep) {
+      StepInput in;
+      in.time = t;
+      RhProblem& problem = in.problem;
+      problem.frame = ofn::GuidanceFrame::from_leg(leg_from, target);
+      problem.position = p;
+      problem.velocity = v;
+      problem.acceleration = a;
+      problem.target = target;
+      problem.terminal_x = problem.frame.to_guidance(target).x();
+      problem.stop_at_target = true;
+      problem.limits = limits;
+      in.global_path = {p, target};
+      in.global_path_changed = k == 0;
+      const auto begin = std::chrono::steady_clock::now();
+      const StepOutput out = planner.step(in);
+      times.push_back(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
+      ++steps;
+      if (out.mode == StepMode::kKeptPrevious) ++kept;
+      if (out.mode != StepMode::kKeptPrevious) {
+        flown = out.trajectory;
+        flown_start = out.start_time;
+      }
+      const double since = t + kStep - flown_start;
+      if (flown.empty() || since > flown.duration()) break;
+      p = flown.position(since);
+      v = flown.velocity(since);
+      a = flown.acceleration(since);
+      if (v.norm() < 0.01 && (p - target).norm() < 0.05) break;
+    }
+  }
+  std::sort(times.begin(), times.end());
+  state.counters["steps"] = steps;
+  state.counters["kept_previous"] = kept;
+  state.counters["median_ms"] = times.empty() ? 0 : 1e3 * times[times.size() / 2];
+  state.counters["max_ms"] = times.empty() ? 0 : 1e3 * times.back();
+}
+BENCHMARK(BM_RhStopAtTheLastWaypoint)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
