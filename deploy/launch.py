@@ -688,11 +688,10 @@ class ResourceWatch:
     class Figures:
         def __init__(self, pid, now, cpu_s):
             self.pid = pid
-            self.started = now
             self.settled_rss = None   # bytes, first sample RESOURCE_SETTLE_S after the start
             self.peak_rss = 0
             self.last_rss = 0
-            self.first_cpu = cpu_s    # CPU time at the first sample, and when
+            self.first_cpu = cpu_s    # CPU time at the first sample (the start), and when
             self.first_at = now
             self.last_cpu = cpu_s
             self.last_at = now
@@ -724,7 +723,7 @@ class ResourceWatch:
             fig = self.figures.get(child.name)
             if fig is None or fig.pid != pid:
                 fig = self.figures[child.name] = ResourceWatch.Figures(pid, now, cpu_s)
-            if fig.settled_rss is None and now - fig.started >= self.settle:
+            if fig.settled_rss is None and now - fig.first_at >= self.settle:
                 fig.settled_rss = rss
             fig.peak_rss = max(fig.peak_rss, rss)
             fig.last_rss = rss
