@@ -84,6 +84,12 @@ int main(int argc, char** argv) {
     ofn::set_log_level(options.log_level);
     ofn::viewer::check(view);
     ofn::viewer::SnapshotHub hub;
+    // The page and its readers see the same shape from the first request:
+    // an empty view (no vehicle yet) until the bus is joined and the
+    // service publishes, never the hub's bare "{}".
+    auto empty_view = ofn::viewer::ViewState(view).snapshot();
+    empty_view["bus"] = {{"received", 0}, {"rejected", 0}};
+    hub.publish(ofn::viewer::ViewState::to_text(empty_view));
     ofn::viewer::HttpServer http(hub, web_root);
     http.bind(address, port);
     http.start();
