@@ -16,7 +16,8 @@ DEBIAN_PACKAGES := cmake make g++ git liblcm-dev liblcm-bin liblcm-java libjchar
   libdynamicedt3d-dev libspdlog-dev libcli11-dev libyaml-cpp-dev libgtest-dev \
   libbenchmark-dev libompl-dev libboost-serialization-dev libboost-filesystem-dev \
   libboost-system-dev python3 python3-matplotlib python3-numpy python3-yaml iproute2 \
-  util-linux procps libcpp-httplib-dev nlohmann-json3-dev pkg-config
+  util-linux procps libcpp-httplib-dev nlohmann-json3-dev pkg-config \
+  libsodium-dev
 # Only `make test` needs these: the headless browser that loads the live
 # viewer's page, and Pillow to read its screenshot. `make run` pulls no browser.
 TEST_PACKAGES := chromium python3-pil

@@ -56,3 +56,9 @@ endif()
 ofn_require(HTTPLIB_FOUND "cpp-httplib" libcpp-httplib-dev)
 add_library(ofn::httplib INTERFACE IMPORTED)
 set_target_properties(ofn::httplib PROPERTIES INTERFACE_LINK_LIBRARIES PkgConfig::HTTPLIB)
+
+# libsodium: Ed25519 signatures of the authenticated bus.
+if(PkgConfig_FOUND)
+  pkg_check_modules(SODIUM QUIET IMPORTED_TARGET libsodium)
+endif()
+ofn_require(SODIUM_FOUND "libsodium" libsodium-dev)

@@ -20,11 +20,14 @@ out=""
 bin="$repo/build/bin"
 no_pin=()
 probe_rate=20
+bus_keys=""
+open_bus=0
 
 usage() {
   cat <<EOF
 usage: deploy/fly_three_hosts.sh [--scenario FILE] [--rtf X] [--out DIR] [--timeout S]
                                  [--bin DIR] [--no-pin] [--probe-rate HZ]
+                                 [--bus-keys DIR | --open-bus]
 
 Flies a scenario on three hosts emulated on this machine: the network
 namespaces gcs, onboard1 and onboard2, joined by a bridge in a fourth
@@ -43,6 +46,11 @@ report and figures are written as deploy/fly.sh writes them. Needs root.
   --bin DIR         service executables (default: build/bin)
   --no-pin          do not pin the services to the table's cores
   --probe-rate HZ   latency probes each host sends per second (default: 20)
+  --bus-keys DIR    authenticate the bus with this keyring (ofn_bus_keygen); the
+                    same directory serves all three hosts
+                    (default: a new keyring for the run in DIR/keyring, each
+                    host given policy.yaml, the public keys and its own key)
+  --open-bus        no authentication: the bus as on one host
   -h, --help        show this help
 
 Besides fly.sh's files, DIR holds onboard1/ and onboard2/ (those hosts'
@@ -69,6 +77,9 @@ while [[ $# -gt 0 ]]; do
     --no-pin) no_pin=(--no-pin); shift ;;
     --probe-rate) need_value "$1" $#; probe_rate=$2; shift 2 ;;
     --probe-rate=*) probe_rate=${1#*=}; shift ;;
+    --bus-keys) need_value "$1" $#; bus_keys=$2; shift 2 ;;
+    --bus-keys=*) bus_keys=${1#*=}; shift ;;
+    --open-bus) open_bus=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) flight_option "$@"; shift "$taken" ;;
   esac
@@ -87,11 +98,34 @@ if [[ $(id -u) != 0 ]]; then
        "(deploy/fly.sh flies on one namespace without)" >&2
   exit 1
 fi
+[[ -n $bus_keys && $open_bus == 1 ]] && die_usage "--bus-keys and --open-bus exclude each other"
+if [[ -n $bus_keys ]]; then
+  [[ -f "$bus_keys/policy.yaml" ]] || die_usage "--bus-keys: $bus_keys holds no policy.yaml (make a keyring with ofn_bus_keygen)"
+  bus_keys=$(cd "$bus_keys" && pwd)
+fi
 [[ -n "$out" ]] || out="$repo/results/run-$(date +%Y%m%d-%H%M%S)"
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
 hosts=(gcs onboard1 onboard2)
+# The authenticated bus (docs/DEPLOYMENT.md#authenticated-bus): by default a
+# keyring made for this run and handed out as on real hosts, each host
+# holding only its own secret key.
+declare -A host_keys=()
+if [[ $open_bus != 1 ]]; then
+  if [[ -z $bus_keys ]]; then
+    "$bin/ofn_bus_keygen" --policy "$repo/config/bus_policy.yaml" --out "$out/keyring" --force \
+      > /dev/null || { echo "fly_three_hosts.sh: error: could not make the run's keyring" >&2; exit 1; }
+    for h in "${hosts[@]}"; do
+      mkdir -m 700 -p "$out/keyring/$h"
+      cp "$out/keyring/policy.yaml" "$out"/keyring/*.pub "$out/keyring/$h/"
+      mv "$out/keyring/$h.key" "$out/keyring/$h/"
+      host_keys[$h]="$out/keyring/$h"
+    done
+  else
+    for h in "${hosts[@]}"; do host_keys[$h]=$bus_keys; done
+  fi
+fi
 # ttl=1: one hop, across the bridge (a switch on real hosts) and no further.
 lcm_url='udpm://239.255.76.67:7667?ttl=1'
 # The probe uses LCM's group on its own port: the same path, not on the bus.
@@ -340,6 +374,11 @@ PY
 # ---------------------------------------------------------------------------
 echo "fly: scenario $scenario, real-time factor $rtf, results in $out"
 say "three hosts: network namespaces $tag-{$hosts_csv} on a bridge in $bridge_ns, LCM $lcm_url"
+if [[ $open_bus == 1 ]]; then
+  say "bus: open (--open-bus), no authentication"
+else
+  say "bus: authenticated, keyring ${bus_keys:-$out/keyring (made for this run, one directory per host)}"
+fi
 make_namespaces
 for h in "${hosts[@]}"; do
   say "  $h: $(ip -n "$tag-$h" -4 -o addr show dev eth0 | awk '{print $4}') on eth0," \
@@ -380,7 +419,8 @@ start_host() {  # start_host NAME LAUNCHER_OPTIONS...
   # stops its services.
   setsid setpriv --pdeathsig TERM ip netns exec "$tag-$h" \
     /usr/bin/python3 "$repo/deploy/launch.py" --host "$h" --scenario "$scenario" --rtf "$rtf" \
-    --bin "$bin" --lcm-url "$lcm_url" "${no_pin[@]}" "$@" \
+    --bin "$bin" --lcm-url "$lcm_url" "${no_pin[@]}" \
+    ${host_keys[$h]:+--bus-keys "${host_keys[$h]}"} "$@" \
     > >(trap '' INT TERM HUP; exec sed -u "s/^/$(printf '%-8s' "$h") | /") 2>&1 &
   launcher_pid[$h]=$!
 }

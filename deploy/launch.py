@@ -340,14 +340,31 @@ def select_processes(table, only=None, host=None):
 
 
 def expand_command(spec, values):
-    """Fill in placeholders; append --config <path> when the entry has one."""
+    """Fill in placeholders; append --config <path> when the entry has one,
+    and on an authenticated bus (values["bus_keys"]) the keyring and the
+    process's host as its role, to the project's own programs (ofn_*)."""
     def substitute(arg):
         return PLACEHOLDER_RE.sub(lambda m: values.get(m.group(1), m.group(0)), arg)
 
     argv = [substitute(a) for a in spec.command]
     if spec.config is not None:
         argv += ["--config", spec.config]
+    if values.get("bus_keys") and os.path.basename(argv[0]).startswith("ofn_"):
+        argv += ["--bus-keys", values["bus_keys"], "--bus-role", spec.host]
     return argv
+
+
+def check_keyring(keyring, specs):
+    """The keyring of --bus-keys holds the policy, every public key and the
+    secret key of each host started here: a TableError names what is not."""
+    if not os.path.isdir(keyring):
+        raise TableError("--bus-keys: directory %s not found (make one with ofn_bus_keygen)" % keyring)
+    needed = ["policy.yaml"] + sorted({"%s.key" % s.host for s in specs})
+    missing = [name for name in needed if not os.path.isfile(os.path.join(keyring, name))]
+    if missing:
+        raise TableError("--bus-keys: %s holds no %s (a host needs policy.yaml, every *.pub "
+                         "and its own <host>.key; see docs/DEPLOYMENT.md)"
+                         % (keyring, ", ".join(missing)))
 
 
 def resolve_executable(program):
@@ -811,6 +828,10 @@ def build_parser():
     parser.add_argument("--only", metavar="NAME[,NAME]",
                         help="start only these processes, comma-separated (default: all)")
     parser.add_argument("--host", help="start only the processes of this host (default: all hosts)")
+    parser.add_argument("--bus-keys", metavar="DIR",
+                        help="authenticated bus: the keyring made by ofn_bus_keygen; every "
+                             "ofn_* process signs and checks as its host's role "
+                             "(default: an open bus)")
     parser.add_argument("--max-restarts", type=int, default=5, metavar="N",
                         help="restarts in a row per service before giving up (default: 5)")
     parser.add_argument("--healthy-after", type=float, default=DEFAULT_HEALTHY_AFTER_S, metavar="S",
@@ -870,6 +891,8 @@ def main(argv=None):
         "lcm_url": args.lcm_url,
         "timeout": format_number(args.timeout),
         "log_dir": log_dir,
+        # Not a placeholder: expand_command adds --bus-keys/--bus-role.
+        "bus_keys": os.path.abspath(os.path.expanduser(args.bus_keys)) if args.bus_keys else "",
     }
 
     # Everything is checked once, before anything starts.
@@ -878,6 +901,8 @@ def main(argv=None):
         specs = select_processes(table, args.only, args.host)
         check_yaml_file(scenario, "--scenario", allow_empty=False)
         check_files(table, specs, values)
+        if values["bus_keys"]:
+            check_keyring(values["bus_keys"], specs)
         logger_exe = None
         if not args.no_record:
             logger_exe = shutil.which("lcm-logger")
@@ -928,7 +953,9 @@ def main(argv=None):
     say("table %s, %d process%s: %s" % (_display_path(table_path), len(specs),
                                       "" if len(specs) == 1 else "es",
                                       ", ".join("%s@%s" % (s.name, s.host) for s in specs)))
-    say("scenario %s, rtf %s, LCM %s" % (scenario, values["rtf"], args.lcm_url))
+    say("scenario %s, rtf %s, LCM %s, bus %s" % (
+        scenario, values["rtf"], args.lcm_url,
+        "authenticated (keyring %s)" % values["bus_keys"] if values["bus_keys"] else "open"))
     pinning = Pinning(not args.no_pin, note)
     if not stdbuf:
         note("stdbuf not found; service output may arrive in blocks")

@@ -13,6 +13,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "ofn/bus_auth/trailer.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/config.hpp"
@@ -72,8 +73,7 @@ Utime utime_of(const Bytes& bytes) {
 
 template <class Msg>
 bool decode(const Bytes& bytes, Msg& msg) {
-  return msg.decode(bytes.data(), 0, static_cast<int>(bytes.size())) ==
-         static_cast<int>(bytes.size());
+  return bus_auth::decode_payload(msg, bytes.data(), bytes.size());
 }
 
 template <class Msg>
@@ -303,25 +303,30 @@ class Session {
     ++result_.events_read;
     if (first_time_ == INT64_MIN) first_time_ = event.timestamp;
     last_time_ = event.timestamp;
+    // A log of an authenticated flight: the replay runs on an open bus and
+    // compares payloads, so the authentication trailer is left off.
+    auto size = static_cast<unsigned>(event.datalen);
+    if (bus_auth::ends_with_trailer(event.data, size)) size -= bus_auth::kTrailerBytes;
     if (follow_sim_clock_) {
       if (event.channel == channels::kSimClock) {
         sim_clock_t tick;
-        if (tick.decode(event.data, 0, event.datalen) == event.datalen) step_to(tick.utime);
+        if (tick.decode(event.data, 0, static_cast<int>(size)) == static_cast<int>(size))
+          step_to(tick.utime);
       }
     } else {
       step_to(event.timestamp);
     }
     if (auto it = channels_.find(event.channel); it != channels_.end()) {
       const auto* data = static_cast<const uint8_t*>(event.data);
-      on_recorded_output(it->second, Bytes(data, data + event.datalen));
+      on_recorded_output(it->second, Bytes(data, data + size));
       return;
     }
     if (replayed_heartbeats_.count(event.channel)) return;
-    write(event.channel, event.data, event.datalen, event.timestamp);
+    write(event.channel, event.data, size, event.timestamp);
     bool consumed = false;
     for (auto& service : services_) {
       if (!service.inputs.count(event.channel)) continue;
-      deliver(service, event.channel, event.data, static_cast<unsigned>(event.datalen));
+      deliver(service, event.channel, event.data, size);
       consumed = true;
     }
     if (consumed) ++result_.inputs_fed;

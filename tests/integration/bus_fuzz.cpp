@@ -16,6 +16,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <thread>
@@ -25,7 +26,9 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "ofn/actuator_cmd_t.hpp"
+#include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/channels.hpp"
+#include "ofn/common/clock.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/heartbeat_t.hpp"
@@ -58,7 +61,7 @@ std::vector<uint8_t> with_hostile_int32(const Msg& m, std::mt19937& rng) {
 /// stamps (multicast loops them back).
 void on_sim_clock(const lcm::ReceiveBuffer* rbuf, const std::string&, ofn::Utime* sim_now) {
   ofn::sim_clock_t m;
-  if (m.decode(rbuf->data, 0, rbuf->data_size) != static_cast<int>(rbuf->data_size)) return;
+  if (!ofn::bus_auth::decode_payload(m, rbuf->data, rbuf->data_size)) return;
   if (*sim_now == INT64_MIN || (m.utime >= *sim_now && m.utime - *sim_now < 100 * 1000000LL))
     *sim_now = m.utime;
 }
@@ -66,8 +69,23 @@ void on_sim_clock(const lcm::ReceiveBuffer* rbuf, const std::string&, ofn::Utime
 void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string&,
                   std::map<std::string, ofn::heartbeat_t>* seen) {
   ofn::heartbeat_t hb;
-  if (hb.decode(rbuf->data, 0, rbuf->data_size) == static_cast<int>(rbuf->data_size))
-    (*seen)[hb.service] = hb;
+  if (ofn::bus_auth::decode_payload(hb, rbuf->data, rbuf->data_size)) (*seen)[hb.service] = hb;
+}
+
+/// Signs the forgeries when set (--sign-as): a stranger who holds one
+/// host's key and signs what that host may not publish.
+std::unique_ptr<ofn::bus_auth::Authenticator> g_forger;
+
+template <class Msg>
+void publish_forgery(lcm::LCM& lcm, const std::string& channel, const Msg& msg) {
+  if (!g_forger) {
+    lcm.publish(channel, &msg);
+    return;
+  }
+  std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  g_forger->seal(channel, bytes);
+  lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
 }
 
 /// Well-formed messages that pass validation and must still be refused.
@@ -76,13 +94,13 @@ void publish_forgeries(lcm::LCM& lcm, ofn::Utime now) {
   ofn::sim_clock_t clock{};
   clock.utime = now + 1000 * 1000000LL;
   clock.real_time_factor = 1.0;
-  lcm.publish(ch::kSimClock, &clock);
+  publish_forgery(lcm, ch::kSimClock, clock);
 
   ofn::control_status_t done{};
   done.utime = now;
   done.mode = ofn::control_status_t::DONE;
   done.mission_id = 1;
-  lcm.publish(ch::kControlStatus, &done);
+  publish_forgery(lcm, ch::kControlStatus, done);
 
   ofn::ref_traj_t fast{};
   fast.utime = now;
@@ -94,13 +112,13 @@ void publish_forgeries(lcm::LCM& lcm, ofn::Utime now) {
   fast.position = {{0, 0, -6}, {30, 0, -6}};
   fast.velocity = {{15, 0, 0}, {15, 0, 0}};
   fast.acceleration = {{0, 0, 0}, {0, 0, 0}};
-  lcm.publish(ch::kRefTraj, &fast);
+  publish_forgery(lcm, ch::kRefTraj, fast);
 
   ofn::actuator_cmd_t cmd{};
   cmd.utime = now;
   cmd.collective = 0.1;
   cmd.lon_cyclic = 0.9;
-  lcm.publish(ch::kActuatorCmd, &cmd);
+  publish_forgery(lcm, ch::kActuatorCmd, cmd);
 }
 
 }  // namespace
@@ -114,7 +132,25 @@ int main(int argc, char** argv) {
   app.add_option("--rounds", rounds, "garbage messages per channel and kind");
   app.add_option("--expect", services, "services that must stay alive and count rejections")
       ->required();
+  std::string sign_as, bus_keys;
+  app.add_option("--sign-as", sign_as,
+                 "sign the well-formed forgeries with this role's key from --bus-keys, as "
+                 "if that host signed channels it may not publish");
+  app.add_option("--bus-keys", bus_keys, "keyring holding the --sign-as role's key");
   CLI11_PARSE(app, argc, argv);
+  if (!sign_as.empty()) {
+    // The stranger's own signer lets it sign anything; receivers judge.
+    const std::string dir = bus_keys + "/";
+    auto policy = ofn::bus_auth::PublishPolicy::load(dir + "policy.yaml");
+    policy.allow(sign_as, "*");
+    std::map<std::string, ofn::bus_auth::PublicKey> keys;
+    for (const auto& role : policy.roles())
+      keys[role] = ofn::bus_auth::read_public_key(dir + role + ".pub");
+    const ofn::WallClock wall;
+    g_forger = std::make_unique<ofn::bus_auth::Authenticator>(
+        sign_as, ofn::bus_auth::read_secret_key(dir + sign_as + ".key"), keys, policy,
+        [&wall] { return wall.now(); });
+  }
 
   lcm::LCM lcm(url);
   if (!lcm.good()) return 2;

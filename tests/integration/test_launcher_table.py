@@ -182,6 +182,16 @@ class TableValidationTest(LauncherTestCase):
         self.assertEqual(argv, ["/b/ofn_vehicle_sim", "--rtf", "2",
                                 "--config", "/abs/config/vehicle_sim.yaml"])
 
+    def test_authenticated_bus_gives_the_project_programs_their_host_role(self):
+        sim = launch.ProcessSpec("sim", "onboard1", 1, ["{bin}/ofn_vehicle_sim"])
+        other = launch.ProcessSpec("probe", "gcs", 0, ["/bin/sh", "-c", "true"])
+        values = {"bin": "/b", "bus_keys": "/keys"}
+        self.assertEqual(launch.expand_command(sim, values),
+                         ["/b/ofn_vehicle_sim", "--bus-keys", "/keys", "--bus-role", "onboard1"])
+        self.assertEqual(launch.expand_command(other, values), ["/bin/sh", "-c", "true"])
+        self.assertEqual(launch.expand_command(sim, {"bin": "/b", "bus_keys": ""}),
+                         ["/b/ofn_vehicle_sim"])
+
     def test_selection_by_host_and_only(self):
         table = launch.load_table(self.write_table(self.GOOD_TABLE))
         self.assertEqual([p.name for p in launch.select_processes(table, host="gcs")], ["monitor"])
@@ -285,6 +295,16 @@ class PreflightTest(LauncherTestCase):
         self.marker = os.path.join(self.dir, "started")
         self.assert_rejected(self.run_launcher(table, "--bin", os.path.join(self.dir, "no-build")),
                              "--bin: directory", "no-build not found", "make build")
+
+    def test_keyring_without_the_host_key_is_named(self):
+        table = self.table_with_marker()
+        keyring = os.path.join(self.dir, "keyring")
+        os.makedirs(keyring)
+        self.write("keyring/policy.yaml", "publishers: {gcs: [X]}\n")
+        self.assert_rejected(self.run_launcher(table, "--bus-keys", keyring),
+                             "--bus-keys", "gcs.key", "docs/DEPLOYMENT.md")
+        self.assert_rejected(self.run_launcher(table, "--bus-keys", os.path.join(self.dir, "none")),
+                             "--bus-keys: directory", "ofn_bus_keygen")
 
     def test_missing_lcm_logger_names_the_debian_package(self):
         table = self.table_with_marker()

@@ -383,3 +383,121 @@ TEST_F(NodeTest, AHostileStringLengthIsRejectedAndTheNodeKeepsRunning) {
 
 }  // namespace
 }  // namespace ofn
+
+namespace ofn {
+namespace {
+
+// The authenticated bus through a Node: roles "a" (this process) and "b"
+// (another host) under one policy, on one memq:// handle.
+class AuthenticatedNodeTest : public NodeTest {
+ protected:
+  AuthenticatedNodeTest() {
+    const auto policy = bus_auth::PublishPolicy::parse(
+        "publishers:\n  a: [HEARTBEAT_X, OWN]\n  b: [TEST_NAV]\n", "test policy");
+    for (const char* role : {"a", "b"}) pairs_[role] = bus_auth::generate_key_pair();
+    std::map<std::string, bus_auth::PublicKey> keys;
+    for (const auto& [role, pair] : pairs_) keys[role] = pair.public_key;
+    const auto wall = [this] { return wall_now_; };
+    own_ =
+        std::make_shared<bus_auth::Authenticator>("a", pairs_["a"].secret_key, keys, policy, wall);
+    other_ =
+        std::make_unique<bus_auth::Authenticator>("b", pairs_["b"].secret_key, keys, policy, wall);
+    attach_authenticator(lcm_, own_);
+  }
+  ~AuthenticatedNodeTest() override {
+    node_.reset();
+    detach_authenticator(lcm_);
+  }
+
+  /// `m` encoded, sealed by role b for `channel`, published raw.
+  void send_from_b(const std::string& channel, const nav_state_t& m, bool seal = true) {
+    std::vector<uint8_t> bytes(m.getEncodedSize());
+    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    if (seal) other_->seal(channel, bytes);
+    lcm_.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+    deliver();
+  }
+
+  int64_t wall_now_ = 1'800'000'000'000'000;
+  std::map<std::string, bus_auth::KeyPair> pairs_;
+  std::shared_ptr<bus_auth::Authenticator> own_;
+  std::unique_ptr<bus_auth::Authenticator> other_;
+};
+
+TEST_F(AuthenticatedNodeTest, SignedMessagesPassAndForgeriesAreCountedNotHandled) {
+  Node& node = subscribed();
+  ASSERT_TRUE(node.authenticated());
+  send_from_b(kChannel, nav_at(clock_.now()));
+  ASSERT_EQ(handled_.size(), 1u);
+  EXPECT_EQ(node.counters().received, 1);
+
+  // Unsigned (a stranger with LCM and the types): refused.
+  send_from_b(kChannel, nav_at(clock_.now()), false);
+  // A replay of a signed message.
+  std::vector<uint8_t> bytes(nav_at(clock_.now()).getEncodedSize());
+  nav_at(clock_.now()).encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  other_->seal(kChannel, bytes);
+  lcm_.publish(kChannel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+  lcm_.publish(kChannel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+  deliver();
+  EXPECT_EQ(handled_.size(), 2u);
+  EXPECT_EQ(node.counters().unauthenticated, 2);
+  EXPECT_EQ(node.counters().rejected, 2);
+  EXPECT_EQ(node.counters().rejected_by_reason.count("TEST_NAV: unauthenticated: not signed"), 1u);
+}
+
+TEST_F(AuthenticatedNodeTest, PublishedMessagesAreSignedAndDecodableByLcmsOwnDecoder) {
+  Node& node = subscribed();
+  std::vector<std::vector<uint8_t>> raw;
+  auto* sub = lcm_.subscribeFunction(
+      "OWN",
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&,
+          std::vector<std::vector<uint8_t>>* out) {
+        const auto* data = static_cast<const uint8_t*>(rbuf->data);
+        out->emplace_back(data, data + rbuf->data_size);
+      },
+      &raw);
+  const auto sent = nav_at(clock_.now());
+  node.publish("OWN", sent);
+  deliver();
+  lcm_.unsubscribe(sub);
+  ASSERT_EQ(raw.size(), 1u);
+  const auto& bytes = raw.front();
+  EXPECT_EQ(bytes.size(), static_cast<size_t>(sent.getEncodedSize()) + bus_auth::kTrailerBytes);
+  // LCM's decoder reads the message from the front and stops at its end,
+  // which is what lcm-spy does with the trailer.
+  nav_state_t decoded{};
+  EXPECT_EQ(decoded.decode(bytes.data(), 0, static_cast<int>(bytes.size())), sent.getEncodedSize());
+  EXPECT_EQ(decoded.utime, sent.utime);
+  // Another host's authenticator accepts it as role a's.
+  const auto opened = other_->open("OWN", bytes.data(), bytes.size());
+  EXPECT_TRUE(opened.authentic) << opened.reason;
+  EXPECT_EQ(opened.role, "a");
+}
+
+TEST_F(AuthenticatedNodeTest, APolicyWithoutTheServiceHeartbeatIsAnErrorAtStart) {
+  EXPECT_THROW(Node("y", lcm_, clock_), bus_auth::KeyError);
+}
+
+TEST_F(NodeTest, WithoutAuthenticationATrailerIsIgnoredAndOtherTailsAreNot) {
+  // A replayed log of an authenticated flight reaches an open bus: the
+  // messages decode; bytes after a message that are not a trailer do not.
+  Node& node = subscribed();
+  const auto m = nav_at(clock_.now());
+  std::vector<uint8_t> bytes(m.getEncodedSize());
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  auto signed_bytes = bytes;
+  signed_bytes.resize(bytes.size() + bus_auth::kTrailerBytes, 0);
+  std::memcpy(signed_bytes.data() + signed_bytes.size() - 4, bus_auth::kTrailerMagic.data(), 4);
+  lcm_.publish(kChannel, signed_bytes.data(), static_cast<unsigned int>(signed_bytes.size()));
+  auto tail = bytes;
+  tail.push_back(0);
+  lcm_.publish(kChannel, tail.data(), static_cast<unsigned int>(tail.size()));
+  deliver();
+  EXPECT_EQ(handled_.size(), 1u);
+  EXPECT_EQ(node.counters().rejected, 1);
+  EXPECT_FALSE(node.authenticated());
+}
+
+}  // namespace
+}  // namespace ofn

@@ -5,12 +5,40 @@
 #include <algorithm>
 #include <cctype>
 #include <climits>
+#include <mutex>
 
 #include "ofn/common/channels.hpp"
 #include "ofn/common/logging.hpp"
 #include "ofn/heartbeat_t.hpp"
 
 namespace ofn {
+namespace {
+
+// The authenticator of each LCM handle: set up once by main() before any
+// node exists, read by every node's constructor.
+std::mutex g_authenticators_mutex;
+std::map<const lcm::LCM*, std::shared_ptr<bus_auth::Authenticator>>& authenticators() {
+  static std::map<const lcm::LCM*, std::shared_ptr<bus_auth::Authenticator>> by_handle;
+  return by_handle;
+}
+
+std::shared_ptr<bus_auth::Authenticator> authenticator_of(const lcm::LCM& lcm) {
+  std::lock_guard<std::mutex> lock(g_authenticators_mutex);
+  const auto found = authenticators().find(&lcm);
+  return found == authenticators().end() ? nullptr : found->second;
+}
+
+}  // namespace
+
+void attach_authenticator(lcm::LCM& lcm, std::shared_ptr<bus_auth::Authenticator> authenticator) {
+  std::lock_guard<std::mutex> lock(g_authenticators_mutex);
+  authenticators()[&lcm] = std::move(authenticator);
+}
+
+void detach_authenticator(lcm::LCM& lcm) {
+  std::lock_guard<std::mutex> lock(g_authenticators_mutex);
+  authenticators().erase(&lcm);
+}
 
 std::string heartbeat_channel(const std::string& service) {
   std::string channel = channels::kHeartbeatPrefix;
@@ -22,8 +50,15 @@ Node::Node(std::string name, lcm::LCM& lcm, const Clock& clock)
     : name_(std::move(name)),
       lcm_(lcm),
       clock_(clock),
+      auth_(authenticator_of(lcm)),
       log_(make_logger(name_)),
       period_start_(std::chrono::steady_clock::now()) {
+  // A keyring whose policy forgets this service's heartbeat is found at
+  // start, not a second later by the first heartbeat.
+  if (auth_ && !auth_->may_publish(heartbeat_channel(name_)))
+    throw bus_auth::KeyError("role '" + auth_->role() + "' may not publish on " +
+                             heartbeat_channel(name_) + " (the keyring's policy.yaml): service " +
+                             name_ + " is not on that host");
   add_timer(
       1.0, [this] { publish_heartbeat(); }, "heartbeat");
 }
@@ -179,6 +214,7 @@ void Node::publish_heartbeat() {
   hb.received = counters_.received;
   hb.rejected = counters_.rejected;
   hb.late = counters_.late;
+  hb.unauthenticated = counters_.unauthenticated;
   hb.last_reject_reason = counters_.last_reject_reason;
   hb.loop_time_mean = work_calls_ ? work_total_ / static_cast<double>(work_calls_) : 0.0;
   hb.loop_time_max = work_max_;

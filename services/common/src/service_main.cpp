@@ -35,21 +35,45 @@ void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock, 
     app.add_option("--clock", options.clock,
                    "time source: wall (field) or sim (follow SIM_CLOCK from vehicle_sim)")
         ->check(CLI::IsMember({"wall", "sim"}));
+  app.add_option("--bus-keys", options.bus_keys,
+                 "authenticated bus: keyring directory made by ofn_bus_keygen (default: an "
+                 "open bus)")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--bus-role", options.bus_role,
+                 "authenticated bus: this host's role in the keyring (gcs, onboard1, onboard2)");
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
 }
 
-std::unique_ptr<lcm::LCM> open_lcm(const CommonOptions& options) {
+void LcmCloser::operator()(lcm::LCM* lcm) const {
+  if (!lcm) return;
+  detach_authenticator(*lcm);
+  delete lcm;
+}
+
+LcmHandle open_lcm(const CommonOptions& options) {
   set_log_level(options.log_level);
+  if (options.bus_keys.empty() != options.bus_role.empty())
+    throw std::invalid_argument(
+        "--bus-keys and --bus-role go together: the keyring and this host's role in it");
+  std::shared_ptr<bus_auth::Authenticator> authenticator;
+  if (!options.bus_keys.empty()) {
+    // Sequence numbers are wall time whatever the service's clock: they
+    // order messages between hosts, not simulation events.
+    auto wall = std::make_shared<WallClock>();
+    authenticator = std::make_shared<bus_auth::Authenticator>(bus_auth::load_authenticator(
+        options.bus_keys, options.bus_role, [wall] { return wall->now(); }));
+  }
   std::string url = options.lcm_url;
   if (url.empty()) {
     const char* env = std::getenv("LCM_DEFAULT_URL");
     url = env && *env ? env : kDefaultLcmUrl;
   }
-  auto lcm = std::make_unique<lcm::LCM>(url);
+  LcmHandle lcm(new lcm::LCM(url));
   if (!lcm->good())
     throw std::runtime_error("cannot open LCM at '" + url +
                              "' (is multicast routed? try: ip route add 224.0.0.0/4 dev lo)");
+  if (authenticator) attach_authenticator(*lcm, std::move(authenticator));
   return lcm;
 }
 

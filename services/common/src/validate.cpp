@@ -213,6 +213,8 @@ std::string validate(const control_status_t& m) {
 
 std::string validate(const heartbeat_t& m) {
   if (m.service.empty()) return "no service name";
+  if (m.unauthenticated < 0 || m.unauthenticated > m.rejected)
+    return "unauthenticated count outside 0..rejected";
   return "";
 }
 

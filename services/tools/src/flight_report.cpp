@@ -12,6 +12,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "ofn/actuator_cmd_t.hpp"
+#include "ofn/bus_auth/trailer.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/mission_plan.hpp"
@@ -40,9 +41,22 @@ std::optional<double> percentile(std::vector<double> values, double q) {
   return values[i];
 }
 
+// A message alone, or with the trailer of an authenticated bus.
 template <class Msg>
 bool decode(const lcm::LogEvent& e, Msg& out) {
-  return out.decode(e.data, 0, e.datalen) == static_cast<int>(e.datalen);
+  return e.datalen >= 0 && bus_auth::decode_payload(out, e.data, static_cast<size_t>(e.datalen));
+}
+
+// A text field of a CSV row, quoted when it holds a separator, a quote or a
+// line break (a heartbeat's service name comes from the bus, whoever sent it).
+std::string csv_text(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + "\"";
 }
 
 std::ofstream open_csv(const std::filesystem::path& path, const std::string& header) {
@@ -98,7 +112,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   auto cmd_csv = open_csv(out / "actuator_cmd.csv", "t,collective,lon_cyclic,lat_cyclic,pedal");
   auto hb_csv = open_csv(out / "heartbeats.csv",
                          "t,service,state,received,rejected,late,loop_time_mean,loop_time_max,"
-                         "cpu_fraction");
+                         "cpu_fraction,unauthenticated");
   // Every scan point of a long flight would make a plot unreadable and a
   // file of hundreds of MB: keep every n-th point, up to a budget.
   constexpr size_t kScanPointStride = 7;
@@ -234,9 +248,9 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     } else if (channel.rfind(channels::kHeartbeatPrefix, 0) == 0) {
       heartbeat_t m{};
       if (!decode(e, m)) return false;
-      hb_csv << rel(m.utime) << "," << m.service << "," << m.state << "," << m.received << ","
-             << m.rejected << "," << m.late << "," << m.loop_time_mean << "," << m.loop_time_max
-             << "," << m.cpu_fraction << "\n";
+      hb_csv << rel(m.utime) << "," << csv_text(m.service) << "," << csv_text(m.state) << ","
+             << m.received << "," << m.rejected << "," << m.late << "," << m.loop_time_mean << ","
+             << m.loop_time_max << "," << m.cpu_fraction << "," << m.unauthenticated << "\n";
     }
     return true;
   };

@@ -3,6 +3,7 @@
 // a shared LCM handle. It never reads the wall clock for control decisions:
 // all times come from the Clock it is given.
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 #include <functional>
@@ -14,6 +15,7 @@
 #include <spdlog/spdlog.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/validate.hpp"
 
@@ -32,6 +34,9 @@ struct NodeCounters {
   int64_t received = 0;
   int64_t rejected = 0;
   int64_t late = 0;
+  /// Of the rejected: refused by the authenticated bus (unsigned, forged,
+  /// replayed, or from a role that may not publish on the channel).
+  int64_t unauthenticated = 0;
   std::string last_reject_reason;
   /// By reject_kind of "channel: reason", at most kMaxRejectKinds + 1 entries.
   std::map<std::string, int64_t> rejected_by_reason;
@@ -71,17 +76,22 @@ class Node {
     sub->channel = channel;
     sub->deliver = [this, handler = std::move(handler), options,
                     channel](const lcm::ReceiveBuffer* rbuf) {
+      size_t payload_size = rbuf->data_size;
+      if (auth_) {
+        const auto opened = auth_->open(channel, rbuf->data, rbuf->data_size);
+        if (!opened.authentic) {
+          ++counters_.unauthenticated;
+          reject(channel, "unauthenticated: " + opened.reason);
+          return;
+        }
+        payload_size = opened.payload_size;
+      }
       Msg msg;
       // The generated decoders bound counts and lengths by the bytes left
       // (cmake/HardenLcmDecode.cmake); anything they still throw is one bad
-      // message, not a reason for the service to die.
-      int decoded = -1;
-      try {
-        decoded = msg.decode(rbuf->data, 0, rbuf->data_size);
-      } catch (const std::exception&) {
-        decoded = -1;
-      }
-      if (decoded != static_cast<int>(rbuf->data_size)) {
+      // message, not a reason for the service to die. Without
+      // authentication a trailer is ignored (a replayed authenticated log).
+      if (!bus_auth::decode_payload(msg, rbuf->data, payload_size)) {
         reject(channel, "undecodable (" + std::to_string(rbuf->data_size) + " bytes)");
         return;
       }
@@ -96,10 +106,24 @@ class Node {
     add_subscription(std::move(sub));
   }
 
+  /// Publishes `msg`; on an authenticated bus signed, with its trailer.
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
-    lcm_.publish(channel, &msg);
+    if (!auth_) {
+      lcm_.publish(channel, &msg);
+      return;
+    }
+    const int size = msg.getEncodedSize();
+    publish_buffer_.resize(static_cast<size_t>(std::max(size, 0)));
+    if (size < 0 || msg.encode(publish_buffer_.data(), 0, size) != size)
+      throw std::runtime_error(channel + ": message could not be encoded");
+    auth_->seal(channel, publish_buffer_);
+    lcm_.publish(channel, publish_buffer_.data(),
+                 static_cast<unsigned int>(publish_buffer_.size()));
   }
+
+  /// True when this node signs and checks every message (--bus-keys).
+  bool authenticated() const { return auth_ != nullptr; }
 
   /// Calls `callback` every `period` seconds of clock time, first at the first
   /// tick of the node's clock that is a whole multiple of the period.
@@ -145,6 +169,8 @@ class Node {
   std::string name_;
   lcm::LCM& lcm_;
   const Clock& clock_;
+  std::shared_ptr<bus_auth::Authenticator> auth_;
+  std::vector<uint8_t> publish_buffer_;
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
   std::vector<Timer> timers_;
@@ -162,6 +188,13 @@ class Node {
   Utime last_reject_log_ = INT64_MIN;
   int64_t suppressed_rejects_ = 0;
 };
+
+/// Makes every Node made on `lcm` from now on sign what it publishes and
+/// accept only what `authenticator` finds authentic (an authenticated bus,
+/// docs/DEPLOYMENT.md). open_lcm() does this for --bus-keys; detach before
+/// the handle is destroyed (open_lcm's handle does it itself).
+void attach_authenticator(lcm::LCM& lcm, std::shared_ptr<bus_auth::Authenticator> authenticator);
+void detach_authenticator(lcm::LCM& lcm);
 
 /// Heartbeat channel of a service: HEARTBEAT_<NAME>.
 std::string heartbeat_channel(const std::string& service);

@@ -25,6 +25,10 @@ struct CommonOptions {
   std::string lcm_url;  // empty: $LCM_DEFAULT_URL or kDefaultLcmUrl
   std::string clock = "wall";
   std::string log_level = "info";
+  // Authenticated bus (docs/DEPLOYMENT.md): the keyring directory and this
+  // host's role in it; both empty: an open bus.
+  std::string bus_keys;
+  std::string bus_role;
 };
 
 /// Adds --lcm-url and --log-level, and --clock / --config for programs that
@@ -32,9 +36,17 @@ struct CommonOptions {
 void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock = true,
                         bool with_config = true);
 
-/// Applies the log level and opens the LCM handle; throws with a clear
-/// message if the URL cannot be opened.
-std::unique_ptr<lcm::LCM> open_lcm(const CommonOptions& options);
+/// Deletes an LCM handle opened by open_lcm(), and forgets its authenticator.
+struct LcmCloser {
+  void operator()(lcm::LCM* lcm) const;
+};
+using LcmHandle = std::unique_ptr<lcm::LCM, LcmCloser>;
+
+/// Applies the log level and opens the LCM handle, authenticated when
+/// --bus-keys is given (every node made on it then signs and checks);
+/// throws with a clear message if the URL cannot be opened or the keyring
+/// cannot be used.
+LcmHandle open_lcm(const CommonOptions& options);
 
 /// The clock named by --clock: "wall" or "sim" (follows SIM_CLOCK).
 std::unique_ptr<Clock> make_clock(const std::string& kind);
