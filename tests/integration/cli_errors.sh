@@ -34,6 +34,17 @@ expect_error "File does not exist" "$BIN/ofn_controller" --config "$WORK/missing
 printf 'not: [valid' > "$WORK/broken.yaml"
 expect_error "broken.yaml: line" "$BIN/ofn_sim_runner" --scenario "$WORK/broken.yaml"
 expect_error "no NAV_STATE\|cannot read" "$BIN/ofn_flight_report" --log "$WORK/ctl.yaml" --out "$WORK/r"
+# The authenticated bus: a keyring that cannot be used is an input error
+# naming the file or the role, before the service joins the bus.
+"$BIN/ofn_bus_keygen" --policy "$REPO/config/bus_policy.yaml" --out "$WORK/keys" > /dev/null ||
+  fail "ofn_bus_keygen could not make a keyring"
+expect_error "already holds a keyring" "$BIN/ofn_bus_keygen" --out "$WORK/keys"
+expect_error "go together" "$BIN/ofn_controller" --bus-keys "$WORK/keys"
+expect_error "role 'gcs' may not publish on HEARTBEAT_CONTROLLER" \
+  "$BIN/ofn_controller" --bus-keys "$WORK/keys" --bus-role gcs
+expect_error "is not in .*policy.yaml" "$BIN/ofn_mapper" --bus-keys "$WORK/keys" --bus-role ground
+chmod 644 "$WORK/keys/onboard2.key"
+expect_error "may be read by others" "$BIN/ofn_mapper" --bus-keys "$WORK/keys" --bus-role onboard2
 # The viewer: one line for a usage error, the same exit code 2.
 expect_error "^ofn_viewer: error: .*--port" "$BIN/ofn_viewer" --port 70000
 [[ $(wc -l < "$WORK/out.txt") -eq 1 ]] || { cat "$WORK/out.txt"; fail "ofn_viewer's usage error is not one line"; }
