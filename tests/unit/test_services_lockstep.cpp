@@ -21,6 +21,7 @@
 #include "ofn/controller/controller_service.hpp"
 #include "ofn/mission_uplink/mission_uplink_service.hpp"
 #include "ofn/sim/lockstep.hpp"
+#include "ofn/solver_stats_t.hpp"
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
 
 namespace ofn {
@@ -41,6 +42,7 @@ control::ControllerConfig default_controller_config() {
 struct FlightResult {
   bool arrived = false;
   Vec3 final_position = Vec3::Zero();
+  double final_speed = 0;
   double time = 0;
   int64_t messages = 0;
   int64_t controller_rejected = 0;
@@ -49,7 +51,36 @@ struct FlightResult {
   std::vector<std::pair<double, double>> yaw_references;  // t, rad (CONTROL_STATUS)
 };
 
-FlightResult fly_open_course(const Scenario& scenario, bool scanner = true) {
+/// The planner's word as the controller's PerceptionWatch hears it: a
+/// SOLVER_STATS "path clear" on a map of now, at 10 Hz, until `silent_after`
+/// seconds (a dead optimiser, or a mapper that gets no scans).
+class PlannerStandIn {
+ public:
+  PlannerStandIn(sim::Lockstep& lockstep, double silent_after)
+      : node_("planner_stand_in", lockstep.lcm(), lockstep.clock()), silent_after_(silent_after) {
+    node_.add_timer(
+        0.1, [this] { publish(); }, "status");
+  }
+  Node& node() { return node_; }
+
+ private:
+  void publish() {
+    const Utime now = node_.now();
+    if (to_seconds(now) >= silent_after_) return;
+    solver_stats_t s{};
+    s.utime = now;
+    s.status = solver_stats_t::NOT_RUN;
+    s.message = "nominal guidance: path clear";
+    s.map_utime = now;
+    node_.publish(channels::kSolverStats, s);
+  }
+  Node node_;
+  double silent_after_;
+};
+
+FlightResult fly_open_course(const Scenario& scenario, bool scanner = true,
+                             double planner_silent_after = std::numeric_limits<double>::infinity(),
+                             double time_limit = 150.0) {
   sim::Lockstep lockstep;
   auto sim_config = default_sim_config();
   sim_config.lidar.enabled = scanner;
@@ -60,17 +91,20 @@ FlightResult fly_open_course(const Scenario& scenario, bool scanner = true) {
   lockstep.add(vehicle.node());
   lockstep.add(uplink.node());
   lockstep.add(controller.node());
+  PlannerStandIn planner(lockstep, planner_silent_after);
+  lockstep.add(planner.node());
   FlightResult r;
   Node recorder("recorder", lockstep.lcm(), lockstep.clock());
   recorder.subscribe<control_status_t>(channels::kControlStatus, [&](const control_status_t& m) {
     r.yaw_references.emplace_back(to_seconds(m.utime), m.yaw_reference);
   });
-  r.arrived = lockstep.run(to_utime(150.0), [&] {
+  r.arrived = lockstep.run(to_utime(time_limit), [&] {
     if (r.modes.empty() || r.modes.back() != controller.mode())
       r.modes.push_back(controller.mode());
     return controller.mode() == control_status_t::DONE;
   });
   r.final_position = vehicle.model().state().position;
+  r.final_speed = vehicle.model().state().velocity.norm();
   r.time = to_seconds(lockstep.clock().now());
   r.messages = lockstep.messages();
   r.controller_rejected = controller.node().counters().rejected;
@@ -102,6 +136,31 @@ TEST_F(LockstepServices, OpenCourseFlightArrivesAtTheLastWaypoint) {
   // Nobody rejected anything on a clean run.
   EXPECT_EQ(r.controller_rejected, 0);
   EXPECT_EQ(r.sim_rejected, 0);
+}
+
+TEST_F(LockstepServices, GuidanceStopsWhenThePlannersWordGoesStaleAndNeverStartsWithoutIt) {
+  const Scenario scenario = load_scenario(kOpenScenario);
+  // Confirmed until t = 30 s, then silent: the stop, then the hover.
+  const FlightResult cut = fly_open_course(scenario, true, 30.0, 80.0);
+  EXPECT_FALSE(cut.arrived);
+  ASSERT_FALSE(cut.modes.empty());
+  EXPECT_EQ(cut.modes.back(), control_status_t::SAFE_STOP);
+  EXPECT_LT(cut.final_speed, 0.05);
+  // Where the confirmed flight was at t = 30 s, plus the stop from cruise
+  // (0.8 of the acceleration limit) and the second the watch waits.
+  const FlightResult confirmed =
+      fly_open_course(scenario, true, std::numeric_limits<double>::infinity(), 31.0);
+  const double stopping = stop_from(Vec3::Zero(), Vec3(scenario.cruise_speed, 0, 0),
+                                    0.8 * scenario.limits.max_accel, kStopRampTime, 0.0)
+                              .distance();
+  EXPECT_LT(cut.final_position.x(), confirmed.final_position.x() + stopping + 0.5);
+  EXPECT_GT(cut.final_position.x(), confirmed.final_position.x() + 0.5 * stopping);
+
+  // Never heard: the vehicle stops where the controller takes it over.
+  const FlightResult never = fly_open_course(scenario, true, 0.0, 40.0);
+  EXPECT_FALSE(never.arrived);
+  EXPECT_LT(never.final_speed, 0.05);
+  EXPECT_LT(never.final_position.x() - scenario.start_position.x(), stopping + 1.0);
 }
 
 /// Peak-to-peak yaw reference over a time window (rad).
@@ -296,12 +355,20 @@ class TrajectoryFeeder {
 
 /// The controller alone on the bus at the start of the open course's first
 /// leg: a navigation solution, trajectories from 1 s on, its status recorded.
+/// The controller fed plans alone, with no planner status: waypoint
+/// guidance before the first plan flies on (the PerceptionWatch is tested
+/// by GuidanceStopsWhenThePlannersWordGoesStale...).
+control::ControllerConfig without_watch(control::ControllerConfig config) {
+  config.perception.enabled = false;
+  return config;
+}
+
 struct ControllerFedTrajectories {
   explicit ControllerFedTrajectories(const control::ControllerConfig& config)
       : open(load_scenario(kOpenScenario)),
         nav(lockstep, open.waypoints.front().position),
         feeder(lockstep, uplink::mission_from_scenario(open, 1), open.waypoints.front().position),
-        controller(lockstep.lcm(), lockstep.clock(), config),
+        controller(lockstep.lcm(), lockstep.clock(), without_watch(config)),
         recorder(lockstep) {
     feeder.from = 1.0;
     for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})

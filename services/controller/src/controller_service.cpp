@@ -96,6 +96,13 @@ ControllerConfig load_controller_config(YamlReader& r) {
   c.selector.hold_deceleration =
       selector.number_in("hold_deceleration", c.selector.hold_deceleration, 0.01, 20.0);
   selector.finish();
+  YamlReader perception = r.child("perception_watch");
+  c.perception.enabled = perception.boolean("enabled", c.perception.enabled);
+  c.perception.max_status_age =
+      perception.number_in("max_status_age", c.perception.max_status_age, 0.05, 60.0);
+  c.perception.max_map_age =
+      perception.number_in("max_map_age", c.perception.max_map_age, 0.05, 60.0);
+  perception.finish();
   YamlReader gate = r.child("command_gate");
   c.gate.max_speed = gate.number_in("max_speed", c.gate.max_speed, 0.1, 100.0);
   c.gate.max_vertical_speed =
@@ -223,6 +230,7 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
       controller_(config_.nominal, config_.gains, make_adaptive_element(config_.adaptive)),
       guidance_(config_.guidance),
       selector_(config_.selector),
+      perception_(config_.perception),
       gate_(config_.gate),
       path_heading_(config_.heading),
       sweep_(config_.sweep) {
@@ -236,6 +244,10 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
   node_.subscribe<ref_traj_t>(
       channels::kRefTraj, [this](const ref_traj_t& m) { on_ref_traj(m); },
       SubscribeOptions{config_.ref_traj_timeout, 0.5});
+  // The planner's word on the map (PerceptionWatch judges its age).
+  node_.subscribe<solver_stats_t>(
+      channels::kSolverStats, [this](const solver_stats_t& m) { on_solver_stats(m); },
+      SubscribeOptions{0.0, 0.5});
   if (config_.sweep.enabled)
     node_.subscribe<lidar_scan_t>(
         channels::kLidarRaw, [this](const lidar_scan_t&) { on_lidar_scan(); },
@@ -244,6 +256,10 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
       1.0 / config_.rate, [this] { control_step(); }, "control");
   node_.add_timer(
       1.0 / config_.status_rate, [this] { publish_status(); }, "status");
+}
+
+void ControllerService::on_solver_stats(const solver_stats_t& m) {
+  perception_.on_status(to_seconds(m.utime), m.map_utime > 0 ? to_seconds(m.map_utime) : 0.0);
 }
 
 void ControllerService::on_mission(const mission_t& m) {
@@ -412,7 +428,13 @@ void ControllerService::control_step() {
   Reference ref;
   // The horizontal direction to face, if there is one.
   std::optional<Vec3> facing;
-  if (!guidance_.has_mission()) {
+  if (!guidance_.has_mission() ||
+      (!perception_.confirmed_once() && perception_.settings().enabled && !traj_ref &&
+       (previous == control_status_t::HOLD || previous == control_status_t::NAV_STALE))) {
+    // No mission, or a mission but not yet the planner's word on the way:
+    // the flight has not begun, the hold goes on.
+    if (guidance_.has_mission() && previous != control_status_t::HOLD)
+      node_.log().info("holding for the planner's first status");
     ref =
         selector_.hold(to_seconds(now), x.position, x.velocity, previous != control_status_t::HOLD);
     mode_ = control_status_t::HOLD;
@@ -440,7 +462,31 @@ void ControllerService::control_step() {
     mode_ = control_status_t::SAFE_STOP;
     ref = selector_.safe_stop(to_seconds(now), last_ref_, mission_->limits.max_accel);
     facing = facing_along(ref.velocity, config_.heading.min_speed);
+  } else if (const auto blind = previous == control_status_t::DONE
+                                    ? std::nullopt
+                                    : perception_.stale(to_seconds(now))) {
+    // Guidance flies the leg without a map: not while nobody has checked
+    // it against a fresh one. The stop from the reference flown, then the
+    // hover, until the planner's word is fresh again.
+    if (!selector_.stopping())
+      node_.log().warn("guidance holds at t={:.2f} s: {}: flying a stop", to_seconds(now), *blind);
+    mode_ = control_status_t::SAFE_STOP;
+    // From the reference flown, or, with none flown since navigation
+    // returned, from the vehicle's own state.
+    Reference from = last_ref_;
+    if (previous == control_status_t::NAV_STALE || !last_ref_flown_) {
+      from = Reference{};
+      from.position = x.position;
+      from.velocity = x.velocity;
+    }
+    ref = selector_.safe_stop(to_seconds(now), from, mission_->limits.max_accel);
+    facing = facing_along(ref.velocity, config_.heading.min_speed);
   } else {
+    if (selector_.stopping()) {
+      selector_.end_stop();
+      node_.log().info("guidance resumes at t={:.2f} s: the planner's map is fresh again",
+                       to_seconds(now));
+    }
     if (previous == control_status_t::TRAJECTORY || previous == control_status_t::SAFE_STOP)
       guidance_.resync(x.position, x.velocity);
     const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
@@ -468,6 +514,7 @@ void ControllerService::control_step() {
   if (clamped) node_.reject("reference", "clamped into the envelope and the geofence");
 
   last_ref_ = ref;
+  last_ref_flown_ = true;
   last_out_ = controller_.step(ref, x, dt);
   if (!last_out_.valid) node_.reject("control", "non-finite control output replaced by hover");
   cmd.collective = last_out_.controls.collective;

@@ -162,7 +162,10 @@ void VehicleSimService::on_command(const actuator_cmd_t& m) {
 
 void VehicleSimService::on_control_status(const control_status_t& m) {
   if (released_) return;
-  if (m.mode == control_status_t::WAYPOINT || m.mode == control_status_t::TRAJECTORY) {
+  // A controller flying a stop (a plan gone stale, or guidance held back
+  // because the planner has not confirmed the way) has the vehicle too.
+  if (m.mode == control_status_t::WAYPOINT || m.mode == control_status_t::TRAJECTORY ||
+      m.mode == control_status_t::SAFE_STOP) {
     released_ = true;
     node_.log().info("controller engaged at t={:.2f} s: vehicle released", to_seconds(node_.now()));
   }

@@ -11,6 +11,7 @@
 #include "ofn/controller/command_gate.hpp"
 #include "ofn/controller/heading_reference.hpp"
 #include "ofn/controller/neural_adaptation.hpp"
+#include "ofn/controller/perception_watch.hpp"
 #include "ofn/controller/reference_selector.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
@@ -18,17 +19,19 @@
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/ref_traj_t.hpp"
+#include "ofn/solver_stats_t.hpp"
 
 namespace ofn::control {
 
 struct ControllerConfig {
-  double rate = 100.0;            // Hz, control loop and ACTUATOR_CMD
-  double status_rate = 50.0;      // Hz, CONTROL_STATUS
-  double nav_timeout = 0.2;       // s; older navigation counts as lost
-  double nav_prediction = 0.15;   // s; navigation up to this old is carried forward to now
-  double ref_traj_timeout = 0.5;  // s; an older REF_TRAJ is no longer followed
-  SelectorSettings selector;      // plan jumps refused; the stop when plans go stale
-  CommandGateSettings gate;       // airframe limits and geofence every command keeps
+  double rate = 100.0;                 // Hz, control loop and ACTUATOR_CMD
+  double status_rate = 50.0;           // Hz, CONTROL_STATUS
+  double nav_timeout = 0.2;            // s; older navigation counts as lost
+  double nav_prediction = 0.15;        // s; navigation up to this old is carried forward to now
+  double ref_traj_timeout = 0.5;       // s; an older REF_TRAJ is no longer followed
+  SelectorSettings selector;           // plan jumps refused; the stop when plans go stale
+  PerceptionWatchSettings perception;  // guidance only on the planner's fresh word
+  CommandGateSettings gate;            // airframe limits and geofence every command keeps
   ControllerGains gains;
   AdaptiveConfig adaptive;
   GuidanceConfig guidance;
@@ -53,6 +56,7 @@ class ControllerService {
 
  private:
   void on_nav(const nav_state_t& m) { nav_ = m; }
+  void on_solver_stats(const solver_stats_t& m);
   void on_mission(const mission_t& m);
   // A NOMINAL trajectory hands back to waypoint guidance. Avoidance, a kept
   // previous plan and braking override it (paper 2.1), if they start on the
@@ -71,6 +75,7 @@ class ControllerService {
   TrajectoryController controller_;
   WaypointGuidance guidance_;
   ReferenceSelector selector_;
+  PerceptionWatch perception_;
   CommandGate gate_;
   std::optional<nav_state_t> nav_;
   std::optional<mission_t> mission_;
@@ -80,6 +85,7 @@ class ControllerService {
   PathHeadingFilter path_heading_;
   int active_waypoint_ = -1;
   Reference last_ref_;
+  bool last_ref_flown_ = false;
   ControlOutput last_out_;
   Utime last_step_ = INT64_MIN;
   Utime last_scan_ = INT64_MIN;

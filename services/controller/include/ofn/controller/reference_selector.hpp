@@ -59,6 +59,8 @@ class ReferenceSelector {
     avoiding_ = false;
     stop_.reset();
   }
+  /// A stop flown for another reason (guidance held back) has ended.
+  void end_stop() { stop_.reset(); }
   bool avoiding() const { return avoiding_; }
   bool stopping() const { return stop_.has_value(); }
 

@@ -1,0 +1,56 @@
+#pragma once
+// Whether waypoint guidance may fly on. Guidance flies the leg without a
+// map: it is safe only while the planning side confirms, again and again,
+// that it has checked the leg against a map fresh from the sensor. The RH
+// optimiser's SOLVER_STATS, published at its step rate, says when it
+// looked (its stamp) and on which map (map_utime, the stamp of the grid
+// built from the latest scan it had). A dead, stopped or cut-off
+// optimiser, a mapper that receives no scans (a lossy link drops most of
+// the multi-fragment SCAN_WORLD messages), or no status yet: guidance
+// stops (the controller flies the stop of braking.hpp and hovers) until
+// fresh confirmation returns. Plans already committed by the optimiser are
+// not affected: each carries its own stop in space seen free.
+// Pure core; times in seconds of the caller's clock.
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+
+namespace ofn::control {
+
+struct PerceptionWatchSettings {
+  /// s; the optimiser's last status may be this old (it steps at 10 Hz).
+  double max_status_age = 1.0;
+  /// s; the map that status was checked on may be this old (the scans
+  /// come at 12.5 Hz, the optimiser's field follows at 5 Hz).
+  double max_map_age = 1.0;
+  /// Off: guidance never waits (a controller flown without a planner).
+  bool enabled = true;
+};
+
+class PerceptionWatch {
+ public:
+  explicit PerceptionWatch(PerceptionWatchSettings settings = {}) : settings_(settings) {}
+
+  /// A planner status stamped `stamp`, checked on a map stamped `map_stamp`
+  /// (<= 0: no map yet). Older statuses than the last are ignored.
+  void on_status(double stamp, double map_stamp);
+
+  /// Why guidance may not fly on at `now`, or nullopt when it may.
+  std::optional<std::string> stale(double now) const;
+
+  /// Whether a status on a map has ever come: before it, the flight has
+  /// not begun (the controller goes on holding rather than stopping).
+  bool confirmed_once() const { return confirmed_once_; }
+
+  const PerceptionWatchSettings& settings() const { return settings_; }
+
+ private:
+  PerceptionWatchSettings settings_;
+  double status_stamp_ = -std::numeric_limits<double>::infinity();
+  double map_stamp_ = -std::numeric_limits<double>::infinity();
+  bool confirmed_once_ = false;
+};
+
+}  // namespace ofn::control
