@@ -72,6 +72,7 @@ class PlannerStandIn {
     s.status = solver_stats_t::NOT_RUN;
     s.message = "nominal guidance: path clear";
     s.map_utime = now;
+    s.guidance_clear = true;
     node_.publish(channels::kSolverStats, s);
   }
   Node node_;

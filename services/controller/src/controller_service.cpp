@@ -259,7 +259,8 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
 }
 
 void ControllerService::on_solver_stats(const solver_stats_t& m) {
-  perception_.on_status(to_seconds(m.utime), m.map_utime > 0 ? to_seconds(m.map_utime) : 0.0);
+  perception_.on_status(to_seconds(m.utime), m.map_utime > 0 ? to_seconds(m.map_utime) : 0.0,
+                        m.guidance_clear);
 }
 
 void ControllerService::on_mission(const mission_t& m) {

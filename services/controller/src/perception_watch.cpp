@@ -5,9 +5,10 @@
 
 namespace ofn::control {
 
-void PerceptionWatch::on_status(double stamp, double map_stamp) {
+void PerceptionWatch::on_status(double stamp, double map_stamp, bool guidance_clear) {
   if (!std::isfinite(stamp) || stamp < status_stamp_) return;
   status_stamp_ = stamp;
+  guidance_clear_ = guidance_clear;
   map_stamp_ = map_stamp > 0 && std::isfinite(map_stamp) ? map_stamp
                                                          : -std::numeric_limits<double>::infinity();
   confirmed_once_ = confirmed_once_ || std::isfinite(map_stamp_);
@@ -27,6 +28,7 @@ std::optional<std::string> PerceptionWatch::stale(double now) const {
     why << "the planner's map is " << now - map_stamp_ << " s old";
     return why.str();
   }
+  if (!guidance_clear_) return std::string("the planner has not cleared the leg");
   return std::nullopt;
 }
 

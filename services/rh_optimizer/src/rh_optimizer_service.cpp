@@ -440,8 +440,9 @@ RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
 }
 
 void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::string& message,
-                                       const SolveReport* report) {
+                                       const SolveReport* report, bool guidance_clear) {
   solver_stats_t s{};
+  s.guidance_clear = guidance_clear && field_valid_;
   s.utime = now;
   s.status = status;
   s.message = message;
@@ -511,7 +512,8 @@ void RhOptimizerService::tick() {
       ticks_since_nominal_ = 0;
     }
     note("nominal guidance");
-    return publish_stats(now, solver_stats_t::NOT_RUN, "nominal guidance: path clear", nullptr);
+    return publish_stats(now, solver_stats_t::NOT_RUN, "nominal guidance: path clear", nullptr,
+                         true);
   }
   if (!was_engaged)
     node_.log().info(
@@ -635,7 +637,7 @@ void RhOptimizerService::tick() {
       return publish_stats(now, solver_stats_t::DEFERRED,
                            "no avoidance trajectory yet (" + out.reason +
                                "); conflict still far, nominal guidance continues",
-                           &out.report);
+                           &out.report, true);
     }
   }
   const Utime t0 = to_utime(out.start_time);

@@ -1,7 +1,10 @@
 #pragma once
 // Whether waypoint guidance may fly on. Guidance flies the leg without a
 // map: it is safe only while the planning side confirms, again and again,
-// that it has checked the leg against a map fresh from the sensor. The RH
+// that it has checked the leg against a map fresh from the sensor and
+// found it clear (SOLVER_STATS guidance_clear; while it avoids, its plans
+// are flown instead, and a plan that does not arrive is no licence to fly
+// the blocked leg). The RH
 // optimiser's SOLVER_STATS, published at its step rate, says when it
 // looked (its stamp) and on which map (map_utime, the stamp of the grid
 // built from the latest scan it had). A dead, stopped or cut-off
@@ -34,8 +37,11 @@ class PerceptionWatch {
   explicit PerceptionWatch(PerceptionWatchSettings settings = {}) : settings_(settings) {}
 
   /// A planner status stamped `stamp`, checked on a map stamped `map_stamp`
-  /// (<= 0: no map yet). Older statuses than the last are ignored.
-  void on_status(double stamp, double map_stamp);
+  /// (<= 0: no map yet), saying whether the nominal leg is clear for
+  /// guidance (false while the planner is avoiding, looking around or has no
+  /// route: guidance would fly the blocked leg). Older statuses than the
+  /// last are ignored.
+  void on_status(double stamp, double map_stamp, bool guidance_clear);
 
   /// Why guidance may not fly on at `now`, or nullopt when it may.
   std::optional<std::string> stale(double now) const;
@@ -51,6 +57,7 @@ class PerceptionWatch {
   double status_stamp_ = -std::numeric_limits<double>::infinity();
   double map_stamp_ = -std::numeric_limits<double>::infinity();
   bool confirmed_once_ = false;
+  bool guidance_clear_ = false;
 };
 
 }  // namespace ofn::control

@@ -126,8 +126,10 @@ class RhOptimizerService {
   /// Forgets the planner's previous plan, the last published one and the
   /// engagement's stop and stall flags (a new mission, a hand-back).
   void restart_planning();
+  /// `guidance_clear`: the nominal leg was checked on the current field and
+  /// waypoint guidance may fly it (the controller's PerceptionWatch).
   void publish_stats(Utime now, int8_t status, const std::string& message,
-                     const SolveReport* report);
+                     const SolveReport* report, bool guidance_clear = false);
 
   Node node_;
   RhOptimizerServiceConfig config_;
