@@ -1,0 +1,342 @@
+#!/usr/bin/python3
+"""Fault suite: a course flown on the three-host split under one fault at a time, judged and tabled.
+
+Usage: fault_suite.py [--scenario FILE] [--rtf X] [--out DIR] [--only NAME[,NAME]] [--list]
+                      [--bin DIR] [--open-bus]
+
+Each row flies the scenario (default bench3, the wall) with
+deploy/fly_three_hosts.sh: gcs, onboard1 and onboard2 in network namespaces
+joined by a bridge, the bus authenticated. The fault is applied from this
+script, in the run's own namespaces only:
+
+  none                    the reference flight
+  loss-10/30/50           that share of the datagrams dropped on every link
+                          between hosts, the whole flight (nftables numgen in
+                          the bridge's namespace)
+  blackout-2s             nothing from onboard2 reaches onboard1 for 2 s, once
+                          avoidance has engaged
+  kill-SERVICE            kill -9 of the service once avoidance has engaged
+                          (the launcher restarts it)
+  stop-SERVICE            SIGSTOP of the service for 3 s, then SIGCONT
+  starve-onboard2         a busy process on onboard2's core for 10 s
+
+Every flight is judged by the benchmark rules (ofn_flight_report: true speed
+and clearance, the verdict success / safe stop / failure). Writes
+OUT/report.md and OUT/results.json; each row's run is in OUT/<name>/.
+Progress is printed per row. Exit code 1 when any row's outcome is failure,
+2 for bad arguments. Needs root (network namespaces) and nftables
+(`make faults` installs it).
+
+Delay, jitter, duplication and reordering between hosts are not in the
+suite: this kernel has no sch_netem, and they need a userspace NFQUEUE
+program that the project does not have yet (docs/LIMITATIONS.md).
+"""
+import argparse
+import datetime
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+FLY3 = os.path.join(REPO, "deploy", "fly_three_hosts.sh")
+
+# deploy/processes.yaml's services (the flight monitor ends the run when it
+# exits, so it is not killed here) and the executables' names as the kernel
+# shows them (comm is cut to 15 characters).
+SERVICES = ["vehicle_sim", "controller", "sensor_interface", "mapper", "global_planner",
+            "rh_optimizer", "mission_uplink", "obstacle_injector"]
+HOSTS = ["gcs", "onboard1", "onboard2"]
+ENGAGED = "avoidance engages"
+FT = 0.3048
+
+
+def comm_of(service):
+    return ("ofn_" + service)[:15]
+
+
+def rows():
+    """Every row: name -> (description, trigger, action). The trigger is
+    "start" (the recording has begun) or "engaged" (the RH optimiser has
+    taken over in front of the obstacle, plus 1 s)."""
+    table = {"none": ("no fault", "start", None)}
+    for share in (10, 30, 50):
+        table["loss-%d" % share] = ("%d %% of datagrams dropped on every link" % share, "start",
+                                    ("loss", share))
+    table["blackout-2s"] = ("onboard2 -> onboard1 cut for 2 s", "engaged", ("blackout", 2.0))
+    for service in SERVICES:
+        table["kill-" + service] = ("kill -9 " + service, "engaged", ("kill", service))
+    for service in SERVICES:
+        table["stop-" + service] = ("SIGSTOP " + service + " for 3 s", "engaged", ("stop", service))
+    table["starve-onboard2"] = ("busy process on onboard2's core for 10 s", "engaged",
+                                ("starve", "onboard2"))
+    return table
+
+
+class Run:
+    """One fly_three_hosts.sh run, its output read line by line."""
+
+    def __init__(self, out_dir, args):
+        self.out_dir = out_dir
+        self.lines = []
+        self.tag = None
+        self.engaged = threading.Event()
+        cmd = [FLY3, "--scenario", args.scenario, "--rtf", str(args.rtf), "--out", out_dir,
+               "--timeout", str(args.timeout), "--bin", args.bin]
+        if args.open_bus:
+            cmd.append("--open-bus")
+        self.output = open(os.path.join(out_dir, "fly.txt"), "w")
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                     text=True, cwd=REPO)
+        self.reader = threading.Thread(target=self._read, daemon=True)
+        self.reader.start()
+
+    def _read(self):
+        for line in self.proc.stdout:
+            self.output.write(line)
+            self.lines.append(line)
+            m = re.match(r"fly3: three hosts: network namespaces (\S+)-\{", line)
+            if m:
+                self.tag = m.group(1)
+            if ENGAGED in line:
+                self.engaged.set()
+        self.output.close()
+
+    def namespace(self, host):
+        return "%s-%s" % (self.tag, host)
+
+    def pids(self, host, comm):
+        """Processes named `comm` inside the run's namespace of `host`."""
+        listed = subprocess.run(["ip", "netns", "pids", self.namespace(host)],
+                                capture_output=True, text=True).stdout.split()
+        found = []
+        for pid in listed:
+            try:
+                with open("/proc/%s/comm" % pid) as f:
+                    if f.read().strip() == comm:
+                        found.append(int(pid))
+            except OSError:
+                pass
+        return found
+
+    def alive(self):
+        return self.proc.poll() is None
+
+
+def host_of(service):
+    return {"vehicle_sim": "onboard1", "controller": "onboard1", "sensor_interface": "onboard1",
+            "mapper": "onboard2", "global_planner": "onboard2", "rh_optimizer": "onboard2",
+            "mission_uplink": "gcs", "obstacle_injector": "gcs"}[service]
+
+
+def nft(run, *commands):
+    for command in commands:
+        subprocess.run(["ip", "netns", "exec", run.namespace("bridge"), "nft"] + command,
+                       check=True, capture_output=True, text=True)
+
+
+def add_fault_table(run):
+    nft(run, ["add", "table", "bridge", "ofn_faults"],
+        ["add", "chain", "bridge", "ofn_faults", "forward",
+         "{ type filter hook forward priority 0; policy accept; }"])
+
+
+def apply(run, action, note):
+    """Applies the fault; returns a short record of what was done."""
+    kind, value = action
+    if kind == "loss":
+        add_fault_table(run)
+        nft(run, ["add", "rule", "bridge", "ofn_faults", "forward", "numgen", "random", "mod",
+                  "100", "<", str(value), "drop"])
+        return "dropping %d %% on every link" % value
+    if kind == "blackout":
+        add_fault_table(run)
+        nft(run, ["add", "rule", "bridge", "ofn_faults", "forward", "iifname", "onboard2",
+                  "oifname", "onboard1", "drop"])
+        time.sleep(value)
+        nft(run, ["flush", "chain", "bridge", "ofn_faults", "forward"])
+        return "onboard2 -> onboard1 cut for %.1f s" % value
+    if kind in ("kill", "stop"):
+        pids = run.pids(host_of(value), comm_of(value))
+        if not pids:
+            return "no %s process found" % value
+        if kind == "kill":
+            for pid in pids:
+                os.kill(pid, signal.SIGKILL)
+            return "killed %s (pid %s)" % (value, ",".join(map(str, pids)))
+        for pid in pids:
+            os.kill(pid, signal.SIGSTOP)
+        time.sleep(3.0)
+        for pid in pids:
+            try:
+                os.kill(pid, signal.SIGCONT)
+            except ProcessLookupError:
+                pass
+        return "stopped %s (pid %s) for 3 s" % (value, ",".join(map(str, pids)))
+    if kind == "starve":
+        # The table's core of onboard2's planner: its busiest service.
+        core = core_of("rh_optimizer")
+        busy = subprocess.Popen(["ip", "netns", "exec", run.namespace(value), "taskset", "-c",
+                                 str(core), "/bin/sh", "-c", "while :; do :; done"])
+        time.sleep(10.0)
+        busy.kill()
+        busy.wait()
+        return "busy loop on core %d in %s for 10 s" % (core, value)
+    raise ValueError(kind)
+
+
+def core_of(service):
+    """The core deploy/processes.yaml pins `service` to, clamped to this machine."""
+    sys.path.insert(0, os.path.join(REPO, "deploy"))
+    import launch  # noqa: E402
+    table = launch.load_table(os.path.join(REPO, "deploy", "processes.yaml"))
+    spec = next(p for p in table.processes if p.name == service)
+    return min(spec.core, (os.cpu_count() or 1) - 1)
+
+
+def fly_row(name, row, args):
+    description, trigger, action = row
+    out_dir = os.path.join(args.out, name)
+    shutil.rmtree(out_dir, ignore_errors=True)
+    os.makedirs(out_dir)
+    begin = time.monotonic()
+    run = Run(out_dir, args)
+    applied = "none"
+    # Wait for the moment of the fault (gcs records: the flight is starting;
+    # or avoidance has engaged), or the end of the run.
+    def due():
+        if trigger == "start":
+            return os.path.exists(os.path.join(out_dir, "latest_log"))
+        return run.engaged.is_set()
+
+    while run.alive() and not due():
+        time.sleep(0.2)
+    if action is not None and run.alive() and run.tag:
+        if trigger == "engaged":
+            time.sleep(1.0)
+        try:
+            applied = apply(run, action, description)
+        except (subprocess.CalledProcessError, OSError) as e:
+            applied = "could not apply: %s" % (getattr(e, "stderr", None) or e)
+    elif action is not None:
+        applied = "not applied: the run ended first" if not run.alive() else \
+            "not applied: no %s" % ("namespaces" if not run.tag else trigger)
+    code = run.proc.wait()
+    run.reader.join()
+    result = {"name": name, "fault": description, "applied": applied, "exit_code": code,
+              "wall_s": round(time.monotonic() - begin, 1)}
+    summary_path = os.path.join(out_dir, "summary.json")
+    if os.path.exists(summary_path):
+        with open(summary_path) as f:
+            s = json.load(f)
+        result.update({
+            "outcome": s["outcome"], "failures": s.get("failures", []),
+            "max_speed_ft_s": s["max_speed"] / FT,
+            "speed_limit_ft_s": s["limits"]["max_speed"] / FT,
+            "min_clearance_ft": s["min_clearance"] / FT,
+            "clearance_required_ft": s["clearance_required"] / FT,
+            "gate_to_gate_s": s.get("gate_to_gate"),
+        })
+    else:
+        result.update({"outcome": "no report", "failures": ["no flight report (exit %d)" % code]})
+    restarts = sum(1 for line in run.lines if "restarting" in line.lower())
+    result["restarts"] = restarts
+    return result
+
+
+def fmt(value, spec):
+    return "-" if value is None else spec % value
+
+
+def write_report(results, args, started):
+    with open(os.path.join(args.out, "results.json"), "w") as f:
+        json.dump({"scenario": args.scenario, "rtf": args.rtf, "open_bus": args.open_bus,
+                   "started": started, "rows": results}, f, indent=1)
+    lines = ["# Fault suite", "",
+             "Scenario %s at real-time factor %s on three hosts (network namespaces on a bridge), "
+             "bus %s; started %s on %s (%d cores)." % (
+                 os.path.relpath(args.scenario, REPO), args.rtf,
+                 "open" if args.open_bus else "authenticated", started, os.uname().nodename,
+                 os.cpu_count() or 0), "",
+             "| fault | outcome | max speed (ft/s) | least clearance (ft) | gate to gate (s) "
+             "| restarts | applied | failures |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        lines.append("| %s | %s | %s | %s | %s | %d | %s | %s |" % (
+            r["fault"], r["outcome"], fmt(r.get("max_speed_ft_s"), "%.2f"),
+            fmt(r.get("min_clearance_ft"), "%.1f"), fmt(r.get("gate_to_gate_s"), "%.2f"),
+            r["restarts"], r["applied"], "; ".join(r["failures"]) or "-"))
+    with open(os.path.join(args.out, "report.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def main(argv=None):
+    table = rows()
+    parser = argparse.ArgumentParser(
+        description="Flies a course on the three-host split under one fault at a time and tables "
+                    "the verdicts (see the module's docstring).")
+    parser.add_argument("--scenario", default=os.path.join(REPO, "sim", "scenarios", "bench3.yaml"),
+                        metavar="FILE", help="course to fly (default: sim/scenarios/bench3.yaml)")
+    parser.add_argument("--rtf", type=float, default=1.0, metavar="X",
+                        help="real-time factor (default: 1; faults are in wall time)")
+    parser.add_argument("--out", metavar="DIR",
+                        help="results folder (default: results/faults-YYYYmmdd-HHMMSS)")
+    parser.add_argument("--only", metavar="NAME[,NAME]", help="rows to fly (default: all; --list)")
+    parser.add_argument("--list", action="store_true", help="list the rows and exit")
+    parser.add_argument("--bin", default=os.path.join(REPO, "build", "bin"), metavar="DIR",
+                        help="service executables (default: build/bin)")
+    parser.add_argument("--timeout", type=float, default=300.0, metavar="S",
+                        help="wall-clock limit of each flight (default: 300)")
+    parser.add_argument("--open-bus", action="store_true", help="fly without authentication")
+    args = parser.parse_args(argv)
+    if args.list:
+        for name, (description, trigger, _) in table.items():
+            print("%-26s %s (%s)" % (name, description,
+                                     "from the start" if trigger == "start" else
+                                     "once avoidance engages"))
+        return 0
+    names = list(table)
+    if args.only:
+        names = [n.strip() for n in args.only.split(",") if n.strip()]
+        unknown = [n for n in names if n not in table]
+        if unknown:
+            parser.error("unknown row(s) %s (see --list)" % ", ".join(unknown))
+    if not args.rtf > 0:
+        parser.error("--rtf must be > 0")
+    if os.geteuid() != 0:
+        sys.stderr.write("fault_suite.py: error: the hosts' network namespaces need root\n")
+        return 2
+    if shutil.which("nft") is None and any(n.startswith(("loss", "blackout")) for n in names):
+        sys.stderr.write("fault_suite.py: error: nft not found (apt-get install nftables, or "
+                         "make faults)\n")
+        return 2
+    args.scenario = os.path.abspath(args.scenario)
+    args.bin = os.path.abspath(args.bin)
+    if not args.out:
+        args.out = os.path.join(REPO, "results",
+                                "faults-" + datetime.datetime.now().strftime("%Y%m%d-%H%M%S"))
+    os.makedirs(args.out, exist_ok=True)
+    args.out = os.path.abspath(args.out)
+    started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+    results = []
+    for i, name in enumerate(names, 1):
+        print("[%d/%d] %s: %s ..." % (i, len(names), name, table[name][0]), flush=True)
+        result = fly_row(name, table[name], args)
+        results.append(result)
+        print("    %s; max speed %s ft/s, least clearance %s ft, %d restarts; %s (%.0f s)" % (
+            result["outcome"], fmt(result.get("max_speed_ft_s"), "%.2f"),
+            fmt(result.get("min_clearance_ft"), "%.1f"), result["restarts"], result["applied"],
+            result["wall_s"]), flush=True)
+        write_report(results, args, started)
+    print("report: %s" % os.path.join(args.out, "report.md"))
+    return 1 if any(r["outcome"] not in ("success", "safe_stop") for r in results) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
