@@ -31,7 +31,6 @@ Delay, jitter, duplication and reordering between hosts are not in the
 suite: this kernel has no sch_netem, and they need a userspace NFQUEUE
 program that the project does not have yet (docs/LIMITATIONS.md).
 """
-import argparse
 import datetime
 import json
 import os
@@ -45,6 +44,11 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+
+import campaign_report as cr  # noqa: E402
+
+PROG = "bench/fault_suite.py"
 FLY3 = os.path.join(REPO, "deploy", "fly_three_hosts.sh")
 
 # deploy/processes.yaml's services (the flight monitor ends the run when it
@@ -276,24 +280,39 @@ def write_report(results, args, started):
         f.write("\n".join(lines) + "\n")
 
 
-def main(argv=None):
-    table = rows()
-    parser = argparse.ArgumentParser(
-        description="Flies a course on the three-host split under one fault at a time and tables "
-                    "the verdicts (see the module's docstring).")
+def build_parser():
+    parser = cr.ArgumentParser(
+        PROG, __doc__.splitlines()[0],
+        epilog="Each row flies the course with deploy/fly_three_hosts.sh under one fault,\n"
+               "applied in that run's network namespaces only, and is judged by the\n"
+               "flight report's rules; OUT/report.md and OUT/results.json table them.\n"
+               "\n"
+               "Examples:\n"
+               "  bench/fault_suite.py --list\n"
+               "  bench/fault_suite.py --only loss-30,kill-rh_optimizer --out /tmp/faults\n"
+               "\n"
+               "Exit codes: 0 when no row's outcome is failure; 1 when any is; 2 for bad\n"
+               "arguments, without root, or without nft for the loss rows.")
     parser.add_argument("--scenario", default=os.path.join(REPO, "sim", "scenarios", "bench3.yaml"),
                         metavar="FILE", help="course to fly (default: sim/scenarios/bench3.yaml)")
     parser.add_argument("--rtf", type=float, default=1.0, metavar="X",
-                        help="real-time factor (default: 1; faults are in wall time)")
+                        help="real-time factor; the faults last wall-clock time (default: 1)")
     parser.add_argument("--out", metavar="DIR",
                         help="results folder (default: results/faults-YYYYmmdd-HHMMSS)")
-    parser.add_argument("--only", metavar="NAME[,NAME]", help="rows to fly (default: all; --list)")
-    parser.add_argument("--list", action="store_true", help="list the rows and exit")
+    parser.add_argument("--only", metavar="NAME[,NAME]", help="rows to fly, see --list (default: all)")
+    parser.add_argument("--list", action="store_true", help="list the rows and exit (default: off)")
     parser.add_argument("--bin", default=os.path.join(REPO, "build", "bin"), metavar="DIR",
                         help="service executables (default: build/bin)")
     parser.add_argument("--timeout", type=float, default=300.0, metavar="S",
                         help="wall-clock limit of each flight (default: 300)")
-    parser.add_argument("--open-bus", action="store_true", help="fly without authentication")
+    parser.add_argument("--open-bus", action="store_true",
+                        help="fly without authentication (default: the bus authenticated)")
+    return parser
+
+
+def main(argv=None):
+    table = rows()
+    parser = build_parser()
     args = parser.parse_args(argv)
     if args.list:
         for name, (description, trigger, _) in table.items():
@@ -306,16 +325,13 @@ def main(argv=None):
         names = [n.strip() for n in args.only.split(",") if n.strip()]
         unknown = [n for n in names if n not in table]
         if unknown:
-            parser.error("unknown row(s) %s (see --list)" % ", ".join(unknown))
+            parser.error("unknown row(s) %s; --list lists them" % ", ".join(unknown))
     if not args.rtf > 0:
         parser.error("--rtf must be > 0")
     if os.geteuid() != 0:
-        sys.stderr.write("fault_suite.py: error: the hosts' network namespaces need root\n")
-        return 2
+        parser.error("the hosts' network namespaces need root")
     if shutil.which("nft") is None and any(n.startswith(("loss", "blackout")) for n in names):
-        sys.stderr.write("fault_suite.py: error: nft not found (apt-get install nftables, or "
-                         "make faults)\n")
-        return 2
+        parser.error("nft not found (apt-get install nftables, or make faults)")
     args.scenario = os.path.abspath(args.scenario)
     args.bin = os.path.abspath(args.bin)
     if not args.out:
@@ -339,4 +355,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    cr.run_main(PROG, main)

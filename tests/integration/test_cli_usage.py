@@ -26,7 +26,8 @@ import unittest
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEPLOY = os.path.join(REPO_ROOT, "deploy")
 BENCH = os.path.join(REPO_ROOT, "bench")
-BENCH_SCRIPTS = ("monte_carlo.py", "campaign.py", "random_field.py", "campaign_report.py")
+BENCH_SCRIPTS = ("monte_carlo.py", "campaign.py", "random_field.py", "campaign_report.py",
+                 "fault_suite.py")
 HIDDEN_MODULES = ("numpy", "matplotlib", "yaml")
 
 
