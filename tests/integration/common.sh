@@ -13,3 +13,13 @@ WORK=$(mktemp -d /tmp/ofn-it.XXXXXX)
 trap 'rm -rf "$WORK"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 pass() { echo "PASS: $*"; }
+# Named network namespaces need root (a user namespace cannot make them):
+# without them a test that builds hosts of its own is skipped (exit 77).
+skip_without_named_netns() {
+  local probe="ofn-it-probe-$$"
+  if ! ip netns add "$probe" 2> /dev/null; then
+    echo "SKIP: cannot create network namespaces here (needs root)"
+    exit 77
+  fi
+  ip netns del "$probe"
+}

@@ -5,12 +5,7 @@
 # vehicle must not fly on blind: no violation of the benchmark rules
 # (outcome success, or a safe stop when the link allows no progress).
 source "$(dirname "$0")/common.sh"
-probe_ns="ofn-it-probe-$$"
-if ! ip netns add "$probe_ns" 2> /dev/null; then
-  echo "SKIP: cannot create network namespaces here (needs root)"
-  exit 77
-fi
-ip netns del "$probe_ns"
+skip_without_named_netns
 command -v nft > /dev/null || fail "nft is missing: run 'make test-deps' (the Makefile installs nftables)"
 
 status=0

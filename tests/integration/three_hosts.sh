@@ -9,13 +9,7 @@
 # bridge can carry; the bus latency is measured; and afterwards no namespace
 # of the run and no process inside one is left.
 source "$(dirname "$0")/common.sh"
-# Named network namespaces need root (a user namespace cannot make them).
-probe_ns="ofn-it-probe-$$"
-if ! ip netns add "$probe_ns" 2>/dev/null; then
-  echo "SKIP: cannot create network namespaces here (needs root)"
-  exit 77
-fi
-ip netns del "$probe_ns"
+skip_without_named_netns
 
 scenario="$REPO/sim/scenarios/open.yaml"
 status=0

@@ -34,10 +34,16 @@ struct Deployment {
   Deployment() {
     for (const char* role : {"onboard1", "onboard2", "gcs"}) pairs[role] = generate_key_pair();
   }
-  Authenticator as(const std::string& role) {
+  std::map<std::string, PublicKey> public_keys() const {
     std::map<std::string, PublicKey> keys;
     for (const auto& [name, pair] : pairs) keys[name] = pair.public_key;
-    return Authenticator(role, pairs.at(role).secret_key, keys, test_policy(),
+    return keys;
+  }
+  /// Signs as `role` with `secret` (its own by default), under `policy`.
+  Authenticator as(const std::string& role, PublishPolicy policy = test_policy(),
+                   std::map<std::string, PublicKey> keys = {}, const SecretKey* secret = nullptr) {
+    if (keys.empty()) keys = public_keys();
+    return Authenticator(role, secret ? *secret : pairs.at(role).secret_key, keys, policy,
                          [this] { return now; });
   }
 };
@@ -123,10 +129,7 @@ TEST(BusAuthenticator, RoleMayPublishOnlyItsOwnChannels) {
   // misconfigured ground station): refused by the policy.
   PublishPolicy lax = test_policy();
   lax.allow("gcs", "REF_TRAJ");
-  std::map<std::string, PublicKey> keys;
-  for (const auto& [name, pair] : deployment.pairs) keys[name] = pair.public_key;
-  Authenticator forger("gcs", deployment.pairs.at("gcs").secret_key, keys, lax,
-                       [&] { return deployment.now; });
+  auto forger = deployment.as("gcs", lax);
   auto forged = payload(50);
   forger.seal("REF_TRAJ", forged);
   const auto opened = controller.open("REF_TRAJ", forged.data(), forged.size());
@@ -139,11 +142,10 @@ TEST(BusAuthenticator, ClaimingAnotherRoleFailsTheSignature) {
   auto controller = deployment.as("onboard1");
   // The ground station signs with its own key but writes "onboard2" as the
   // role: the signature does not verify under onboard2's public key.
-  std::map<std::string, PublicKey> keys;
-  for (const auto& [name, pair] : deployment.pairs) keys[name] = pair.public_key;
+  auto keys = deployment.public_keys();
   keys["onboard2"] = deployment.pairs.at("gcs").public_key;  // to pass its own key check
-  Authenticator impostor("onboard2", deployment.pairs.at("gcs").secret_key, keys, test_policy(),
-                         [&] { return deployment.now; });
+  auto impostor =
+      deployment.as("onboard2", test_policy(), keys, &deployment.pairs.at("gcs").secret_key);
   auto message = payload(50);
   impostor.seal("REF_TRAJ", message);
   const auto opened = controller.open("REF_TRAJ", message.data(), message.size());
@@ -208,14 +210,9 @@ TEST(BusAuthenticator, RestartedPublisherGoesOnAboveItsOldSequence) {
 
 TEST(BusAuthenticator, MismatchedKeysAreRefusedAtConstruction) {
   Deployment deployment;
-  std::map<std::string, PublicKey> keys;
-  for (const auto& [name, pair] : deployment.pairs) keys[name] = pair.public_key;
-  EXPECT_THROW(Authenticator("onboard1", deployment.pairs.at("gcs").secret_key, keys, test_policy(),
-                             [] { return kNow; }),
-               KeyError);
-  EXPECT_THROW(Authenticator("nobody", deployment.pairs.at("gcs").secret_key, keys, test_policy(),
-                             [] { return kNow; }),
-               KeyError);
+  const auto& gcs_secret = deployment.pairs.at("gcs").secret_key;
+  EXPECT_THROW(deployment.as("onboard1", test_policy(), {}, &gcs_secret), KeyError);
+  EXPECT_THROW(deployment.as("nobody", test_policy(), {}, &gcs_secret), KeyError);
 }
 
 TEST(PublishPolicy, PatternsAndErrors) {
