@@ -38,7 +38,10 @@ expect_error "no NAV_STATE\|cannot read" "$BIN/ofn_flight_report" --log "$WORK/c
 # naming the file or the role, before the service joins the bus.
 "$BIN/ofn_bus_keygen" --policy "$REPO/config/bus_policy.yaml" --out "$WORK/keys" > /dev/null ||
   fail "ofn_bus_keygen could not make a keyring"
-expect_error "already holds a keyring" "$BIN/ofn_bus_keygen" --out "$WORK/keys"
+expect_error "already holds a keyring" "$BIN/ofn_bus_keygen" --policy "$REPO/config/bus_policy.yaml" \
+  --out "$WORK/keys"
+expect_error "cannot read publish policy 'config/bus_policy.yaml' (run from the repository root" \
+  "$BIN/ofn_bus_keygen" --out "$WORK/other-keys"
 expect_error "go together" "$BIN/ofn_controller" --bus-keys "$WORK/keys"
 expect_error "role 'gcs' may not publish on HEARTBEAT_CONTROLLER" \
   "$BIN/ofn_controller" --bus-keys "$WORK/keys" --bus-role gcs

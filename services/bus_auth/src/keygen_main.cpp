@@ -32,6 +32,11 @@ int main(int argc, char** argv) {
 
   return ofn::guarded_main("ofn_bus_keygen", [&] {
     namespace fs = std::filesystem;
+    // The default is the repository's policy, relative to the working
+    // directory: said so when it is not there.
+    if (!std::filesystem::exists(policy_path))
+      throw std::invalid_argument("cannot read publish policy '" + policy_path +
+                                  "' (run from the repository root, or pass --policy FILE)");
     const auto policy = ofn::bus_auth::PublishPolicy::load(policy_path);
     const fs::path dir(out);
     if (fs::exists(dir / "policy.yaml") && !force)
