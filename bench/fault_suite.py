@@ -51,18 +51,36 @@ import campaign_report as cr  # noqa: E402
 PROG = "bench/fault_suite.py"
 FLY3 = os.path.join(REPO, "deploy", "fly_three_hosts.sh")
 
-# deploy/processes.yaml's services (the flight monitor ends the run when it
-# exits, so it is not killed here) and the executables' names as the kernel
-# shows them (comm is cut to 15 characters).
-SERVICES = ["vehicle_sim", "controller", "sensor_interface", "mapper", "global_planner",
-            "rh_optimizer", "mission_uplink", "obstacle_injector"]
-HOSTS = ["gcs", "onboard1", "onboard2"]
+sys.path.insert(0, os.path.join(REPO, "deploy"))
+import launch  # noqa: E402
+
+_process_table = None
+
+
+def process_table():
+    """The process table the flight is launched with: the services, their
+    hosts, cores and executables (read at first use: it needs PyYAML)."""
+    global _process_table
+    if _process_table is None:
+        _process_table = launch.load_table(os.path.join(REPO, "deploy", "processes.yaml"))
+    return _process_table
+
+
+def services():
+    """Every service but the one that ends the run when it exits (the
+    flight monitor), which is not killed here."""
+    return [p.name for p in process_table().processes if not p.ends_run]
 ENGAGED = "avoidance engages"
 FT = 0.3048
 
 
+def spec_of(service):
+    return next(p for p in process_table().processes if p.name == service)
+
+
 def comm_of(service):
-    return ("ofn_" + service)[:15]
+    """The executable's name as the kernel shows it (cut to 15 characters)."""
+    return os.path.basename(spec_of(service).command[0])[:15]
 
 
 def rows():
@@ -74,9 +92,9 @@ def rows():
         table["loss-%d" % share] = ("%d %% of datagrams dropped on every link" % share, "start",
                                     ("loss", share))
     table["blackout-2s"] = ("onboard2 -> onboard1 cut for 2 s", "engaged", ("blackout", 2.0))
-    for service in SERVICES:
+    for service in services():
         table["kill-" + service] = ("kill -9 " + service, "engaged", ("kill", service))
-    for service in SERVICES:
+    for service in services():
         table["stop-" + service] = ("SIGSTOP " + service + " for 3 s", "engaged", ("stop", service))
     table["starve-onboard2"] = ("busy process on onboard2's core for 10 s", "engaged",
                                 ("starve", "onboard2"))
@@ -133,12 +151,6 @@ class Run:
         return self.proc.poll() is None
 
 
-def host_of(service):
-    return {"vehicle_sim": "onboard1", "controller": "onboard1", "sensor_interface": "onboard1",
-            "mapper": "onboard2", "global_planner": "onboard2", "rh_optimizer": "onboard2",
-            "mission_uplink": "gcs", "obstacle_injector": "gcs"}[service]
-
-
 def nft(run, *commands):
     for command in commands:
         subprocess.run(["ip", "netns", "exec", run.namespace("bridge"), "nft"] + command,
@@ -151,7 +163,7 @@ def add_fault_table(run):
          "{ type filter hook forward priority 0; policy accept; }"])
 
 
-def apply(run, action, note):
+def apply(run, action):
     """Applies the fault; returns a short record of what was done."""
     kind, value = action
     if kind == "loss":
@@ -167,7 +179,7 @@ def apply(run, action, note):
         nft(run, ["flush", "chain", "bridge", "ofn_faults", "forward"])
         return "onboard2 -> onboard1 cut for %.1f s" % value
     if kind in ("kill", "stop"):
-        pids = run.pids(host_of(value), comm_of(value))
+        pids = run.pids(spec_of(value).host, comm_of(value))
         if not pids:
             return "no %s process found" % value
         if kind == "kill":
@@ -196,12 +208,8 @@ def apply(run, action, note):
 
 
 def core_of(service):
-    """The core deploy/processes.yaml pins `service` to, clamped to this machine."""
-    sys.path.insert(0, os.path.join(REPO, "deploy"))
-    import launch  # noqa: E402
-    table = launch.load_table(os.path.join(REPO, "deploy", "processes.yaml"))
-    spec = next(p for p in table.processes if p.name == service)
-    return min(spec.core, (os.cpu_count() or 1) - 1)
+    """The core the process table pins `service` to, clamped to this machine."""
+    return min(spec_of(service).core, (os.cpu_count() or 1) - 1)
 
 
 def fly_row(name, row, args):
@@ -225,7 +233,7 @@ def fly_row(name, row, args):
         if trigger == "engaged":
             time.sleep(1.0)
         try:
-            applied = apply(run, action, description)
+            applied = apply(run, action)
         except (subprocess.CalledProcessError, OSError) as e:
             applied = "could not apply: %s" % (getattr(e, "stderr", None) or e)
     elif action is not None:
@@ -311,9 +319,9 @@ def build_parser():
 
 
 def main(argv=None):
-    table = rows()
     parser = build_parser()
     args = parser.parse_args(argv)
+    table = rows()
     if args.list:
         for name, (description, trigger, _) in table.items():
             print("%-26s %s (%s)" % (name, description,
