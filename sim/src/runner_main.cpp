@@ -21,6 +21,7 @@
 #include "ofn/obstacle_injector/obstacle_injector_service.hpp"
 #include "ofn/rh_optimizer/rh_optimizer_service.hpp"
 #include "ofn/sensor_interface/sensor_interface_service.hpp"
+#include "ofn/sim/link_loss.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/tools/flight_report.hpp"
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
@@ -39,7 +40,9 @@ ofn::YamlReader config_in(const std::string& dir, const std::string& file) {
 int main(int argc, char** argv) {
   CLI::App app{"ofn lockstep runner: all services in one process, deterministic and fast"};
   std::string scenario_path, config_dir = "config", out_dir, log_path, log_level = "warn";
-  double max_time = 0, linger = 2.0;
+  std::string process_table = "deploy/processes.yaml";
+  double max_time = 0, linger = 2.0, link_loss = 0.0;
+  uint64_t link_seed = 1;
   bool quiet = false, no_avoidance = false;
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")
       ->required()
@@ -54,6 +57,14 @@ int main(int argc, char** argv) {
   app.add_option("--linger", linger, "simulated seconds to keep flying after arrival");
   app.add_option("--log-level", log_level, "service log level")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  app.add_option("--link-loss", link_loss,
+                 "probability that a datagram between two hosts is lost (hosts from "
+                 "--process-table; a message is lost when any of its fragments is)")
+      ->check(CLI::Range(0.0, 0.99));
+  app.add_option("--link-seed", link_seed, "seed of the link-loss draws")->capture_default_str();
+  app.add_option("--process-table", process_table,
+                 "process table naming each service's host, for --link-loss")
+      ->capture_default_str();
   app.add_flag("--quiet", quiet, "no progress lines");
   app.add_flag("--no-avoidance", no_avoidance,
                "fly without global_planner and rh_optimizer (nominal waypoint guidance only)");
@@ -90,6 +101,26 @@ int main(int argc, char** argv) {
 
     ofn::sim::Lockstep lockstep;
     if (!log_path.empty()) lockstep.record(log_path);
+    std::shared_ptr<ofn::sim::LinkLoss> link;
+    if (link_loss > 0) {
+      link = std::make_shared<ofn::sim::LinkLoss>(ofn::sim::LinkLossConfig{
+          link_loss, link_seed, ofn::sim::load_service_hosts(process_table)});
+      // Every service must have a host before the first message crosses.
+      for (const char* service :
+           {"vehicle_sim", "mission_uplink", "controller", "obstacle_injector", "sensor_interface",
+            "mapper", "global_planner", "rh_optimizer"})
+        try {
+          link->host(service);
+        } catch (const std::out_of_range& e) {
+          throw ofn::ConfigError(process_table + ": " + e.what());
+        }
+      ofn::attach_link_model(lockstep.lcm(), link);
+    }
+    // The services' nodes leave before the handle; the link model with them.
+    struct LinkDetach {
+      lcm::LCM& lcm;
+      ~LinkDetach() { ofn::detach_link_model(lcm); }
+    } link_detach{lockstep.lcm()};
     ofn::vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), scenario,
                                             vehicle_config);
     ofn::uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), scenario_path);
@@ -133,6 +164,20 @@ int main(int argc, char** argv) {
                 simulated, wall, simulated / std::max(wall, 1e-9),
                 static_cast<long long>(lockstep.messages()));
     if (!arrived) std::printf("lockstep: the vehicle did not arrive within %.0f s\n", limit);
+    if (link) {
+      int64_t crossing = 0, lost = 0;
+      std::string by_channel;
+      for (const auto& [channel, count] : link->counts()) {
+        crossing += count.crossing;
+        lost += count.lost;
+        if (count.lost > 0)
+          by_channel += " " + channel + " " + std::to_string(count.lost) + "/" +
+                        std::to_string(count.crossing);
+      }
+      std::printf("link loss %.0f %% per datagram: %lld of %lld messages between hosts lost:%s\n",
+                  100.0 * link_loss, static_cast<long long>(lost), static_cast<long long>(crossing),
+                  by_channel.c_str());
+    }
 
     if (!out_dir.empty()) {
       // Close the log before reading it back.

@@ -28,7 +28,30 @@ std::shared_ptr<bus_auth::Authenticator> authenticator_of(const lcm::LCM& lcm) {
   return found == authenticators().end() ? nullptr : found->second;
 }
 
+// The simulated link of each LCM handle (lockstep runs only).
+std::mutex g_links_mutex;
+std::map<const lcm::LCM*, std::shared_ptr<LinkModel>>& links() {
+  static std::map<const lcm::LCM*, std::shared_ptr<LinkModel>> by_handle;
+  return by_handle;
+}
+
+std::shared_ptr<LinkModel> link_of(const lcm::LCM& lcm) {
+  std::lock_guard<std::mutex> lock(g_links_mutex);
+  const auto found = links().find(&lcm);
+  return found == links().end() ? nullptr : found->second;
+}
+
 }  // namespace
+
+void attach_link_model(lcm::LCM& lcm, std::shared_ptr<LinkModel> link) {
+  std::lock_guard<std::mutex> lock(g_links_mutex);
+  links()[&lcm] = std::move(link);
+}
+
+void detach_link_model(lcm::LCM& lcm) {
+  std::lock_guard<std::mutex> lock(g_links_mutex);
+  links().erase(&lcm);
+}
 
 void attach_authenticator(lcm::LCM& lcm, std::shared_ptr<bus_auth::Authenticator> authenticator) {
   std::lock_guard<std::mutex> lock(g_authenticators_mutex);
@@ -51,6 +74,7 @@ Node::Node(std::string name, lcm::LCM& lcm, const Clock& clock)
       lcm_(lcm),
       clock_(clock),
       auth_(authenticator_of(lcm)),
+      link_(link_of(lcm)),
       log_(make_logger(name_)),
       period_start_(std::chrono::steady_clock::now()) {
   // A keyring whose policy forgets this service's heartbeat is found at

@@ -17,6 +17,7 @@
 
 #include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/clock.hpp"
+#include "ofn/common/link_model.hpp"
 #include "ofn/common/validate.hpp"
 
 namespace ofn {
@@ -76,6 +77,8 @@ class Node {
     sub->channel = channel;
     sub->deliver = [this, handler = std::move(handler), options,
                     channel](const lcm::ReceiveBuffer* rbuf) {
+      // A message the simulated link loses never reached this service.
+      if (link_ && !link_->delivers(name_, channel, rbuf->data_size)) return;
       size_t payload_size = rbuf->data_size;
       if (auth_) {
         const auto opened = auth_->open(channel, rbuf->data, rbuf->data_size);
@@ -109,6 +112,7 @@ class Node {
   /// Publishes `msg`; on an authenticated bus signed, with its trailer.
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
+    if (link_) link_->published(name_, channel);
     if (!auth_) {
       lcm_.publish(channel, &msg);
       return;
@@ -170,6 +174,7 @@ class Node {
   lcm::LCM& lcm_;
   const Clock& clock_;
   std::shared_ptr<bus_auth::Authenticator> auth_;
+  std::shared_ptr<LinkModel> link_;
   std::vector<uint8_t> publish_buffer_;
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
@@ -195,6 +200,12 @@ class Node {
 /// the handle is destroyed (open_lcm's handle does it itself).
 void attach_authenticator(lcm::LCM& lcm, std::shared_ptr<bus_auth::Authenticator> authenticator);
 void detach_authenticator(lcm::LCM& lcm);
+
+/// Makes every Node made on `lcm` from now on send and receive through
+/// `link` (a simulated network, ofn/common/link_model.hpp); detach before
+/// the handle is destroyed.
+void attach_link_model(lcm::LCM& lcm, std::shared_ptr<LinkModel> link);
+void detach_link_model(lcm::LCM& lcm);
 
 /// Heartbeat channel of a service: HEARTBEAT_<NAME>.
 std::string heartbeat_channel(const std::string& service);

@@ -1,0 +1,70 @@
+#pragma once
+// Packet loss between hosts, for the lockstep runner: the three-host split
+// of deploy/processes.yaml flown in one process, with every datagram that
+// crosses from one host to another dropped with a given probability. The
+// draws come from a seeded generator in delivery order, so a lossy lockstep
+// flight repeats to the bit, like a loss-free one.
+//
+// LCM sends a message of more than kShortMessageMax bytes as fragments of
+// kFragmentPayload bytes, and a message is lost when any fragment is: a
+// 9.6 KB scan is 7 datagrams and is lost 52 % of the time at 10 % loss.
+// Each receiving service draws on its own (a host's services share one
+// datagram in reality; drawing apart makes their views of the bus differ
+// more, not less). Services on one host never lose a message.
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <string>
+
+#include "ofn/common/link_model.hpp"
+
+namespace ofn::sim {
+
+/// LCM 1.3.1 UDP multicast framing (lcm_udpm.c).
+constexpr std::size_t kShortMessageMax = 1435;
+constexpr std::size_t kFragmentPayload = 1423;
+
+/// Datagrams LCM sends for a message of `bytes` bytes (channel name aside).
+std::size_t datagrams_for(std::size_t bytes);
+
+/// Which host each service runs on: the `processes:` table of
+/// deploy/processes.yaml (name -> host). Throws ConfigError when unreadable.
+std::map<std::string, std::string> load_service_hosts(const std::string& process_table);
+
+struct LinkLossConfig {
+  double datagram_loss = 0.0;  // probability, [0, 1)
+  std::uint64_t seed = 1;
+  std::map<std::string, std::string> host_of;  // service -> host
+};
+
+class LinkLoss : public LinkModel {
+ public:
+  /// Throws std::invalid_argument for a probability outside [0, 1).
+  explicit LinkLoss(LinkLossConfig config);
+
+  void published(const std::string& publisher, const std::string& channel) override;
+  bool delivers(const std::string& receiver, const std::string& channel,
+                std::size_t bytes) override;
+
+  /// Messages that crossed between hosts, and of those the lost, per channel.
+  struct ChannelCount {
+    std::int64_t crossing = 0;
+    std::int64_t lost = 0;
+  };
+  const std::map<std::string, ChannelCount>& counts() const { return counts_; }
+
+  /// Host of `service`; throws std::out_of_range naming it when unknown.
+  const std::string& host(const std::string& service) const;
+
+ private:
+  LinkLossConfig config_;
+  std::mt19937_64 random_;
+  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
+  // Each channel has one publisher; a heartbeat channel its own service.
+  std::map<std::string, std::string> publisher_host_;
+  std::map<std::string, ChannelCount> counts_;
+};
+
+}  // namespace ofn::sim
