@@ -44,6 +44,7 @@ void TrajectoryController::reset() {
   tail_thrust_estimate_ = hover_tail_thrust_;
   reference_started_ = false;
   actuator_estimate_ = hover_;
+  flap_started_ = false;
   adaptive_->reset();
 }
 
@@ -70,13 +71,10 @@ double TrajectoryController::collective_for_thrust(double thrust, const Vec3& ai
 
 Vec3 TrajectoryController::angular_accel_for(const vehicle::Controls& c, double thrust,
                                              const Vec3& air_body, const Vec3& w,
-                                             double rotor_torque) const {
+                                             double rotor_torque, double flap_lon,
+                                             double flap_lat) const {
   const auto& p = model_.params();
   const double moment_per_flap = thrust * p.hub_height + p.flap_stiffness;
-  const double flap_lon = p.cyclic_to_flap * c.lon_cyclic + p.flap_time_constant * w.y() -
-                          p.flap_blowback * air_body.x();
-  const double flap_lat = p.cyclic_to_flap * c.lat_cyclic - p.flap_time_constant * w.x() -
-                          p.flap_blowback * air_body.y();
   const double tail_flow = air_body.y() - w.z() * p.tail_arm;
   const double tail_thrust = -p.tail_thrust_per_rad * c.pedal - p.tail_velocity_damping * tail_flow;
   const Vec3 moment(moment_per_flap * flap_lat, -moment_per_flap * flap_lon,
@@ -300,8 +298,27 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   const Vec3 accel_achievable =
       (-thrust_achievable * ref_attitude_.toRotationMatrix().col(2) + other_world) / p.mass +
       Vec3(0, 0, kGravity);
-  const Vec3 angular_achievable =
-      angular_accel_for(achievable, thrust_achievable, air_body, w, loads.rotor_torque);
+  // The disk follows the cyclic with the flapping lag, which the inversion
+  // takes as settled: the tilt the nominal rotor has got to from the
+  // servos' positions is what the inner loop can have now. Left out, the
+  // lag reached the inner network as a rate error after every step in the
+  // attitude command, and at its learning rate the network fed it back
+  // into a roll and pitch oscillation of +-0.5 rad with the cyclics swinging
+  // limit to limit (docs/TUNING.md, "Flapping lag in the hedge").
+  const double lon_steady =
+      p.cyclic_to_flap * achievable.lon_cyclic - p.flap_blowback * air_body.x();
+  const double lat_steady =
+      p.cyclic_to_flap * achievable.lat_cyclic - p.flap_blowback * air_body.y();
+  if (!flap_started_) {
+    flap_lon_ = lon_steady + p.flap_time_constant * w.y();
+    flap_lat_ = lat_steady - p.flap_time_constant * w.x();
+    flap_started_ = true;
+  }
+  const double flap_rate = dt / std::max(p.flap_time_constant, dt);
+  flap_lon_ += dt * w.y() - flap_rate * (flap_lon_ - lon_steady);
+  flap_lat_ += -dt * w.x() - flap_rate * (flap_lat_ - lat_steady);
+  const Vec3 angular_achievable = angular_accel_for(achievable, thrust_achievable, air_body, w,
+                                                    loads.rotor_torque, flap_lon_, flap_lat_);
   if (g.hedging) {
     out.hedge_accel = accel_wanted - accel_achievable;
     out.hedge_angular = angular - angular_achievable;
@@ -323,7 +340,8 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
 
   const bool states_finite = ref_position_.allFinite() && ref_velocity_.allFinite() &&
                              ref_rates_.allFinite() && ref_attitude_.coeffs().allFinite() &&
-                             position_integral_.allFinite() && attitude_integral_.allFinite();
+                             position_integral_.allFinite() && attitude_integral_.allFinite() &&
+                             std::isfinite(flap_lon_) && std::isfinite(flap_lat_);
   if (!finite(out.controls) || !out.commanded_accel.allFinite() || !states_finite) {
     out = ControlOutput{};
     out.controls = hover_;

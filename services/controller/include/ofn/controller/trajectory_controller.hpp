@@ -9,7 +9,8 @@
 //               angular-acceleration pseudo-control -> inverted through the
 //               nominal rotor model to cyclic and pedal.
 // Pseudo-control hedging: what the model says the vehicle cannot do (bounds,
-// actuator limits and rates, and for the outer loop the attitude not yet
+// actuator limits and rates, for the inner loop the disk tilt the flapping
+// lag has not yet reached, and for the outer loop the attitude not yet
 // reached) is taken out of each reference model's acceleration, so neither
 // the adaptive element nor the integrators learn from it.
 // The adaptive element plugs in through AdaptiveElement (NeuralAdaptation
@@ -170,10 +171,12 @@ class TrajectoryController {
   double collective_for_thrust(double thrust, const Vec3& air_body) const;
   /// `accel` with the speed governor applied at `velocity`.
   Vec3 govern_speed(const Vec3& accel, const Vec3& velocity) const;
-  /// Angular acceleration the nominal model gives for controls (the
-  /// inverse of the inner loop's inversion).
+  /// Angular acceleration the nominal model gives for the pedal and a disk
+  /// tilted by `flap_lon` / `flap_lat` (rad): the inverse of the inner
+  /// loop's inversion.
   Vec3 angular_accel_for(const vehicle::Controls& c, double thrust, const Vec3& air_body,
-                         const Vec3& body_rates, double rotor_torque) const;
+                         const Vec3& body_rates, double rotor_torque, double flap_lon,
+                         double flap_lat) const;
 
   vehicle::RotorcraftModel model_;
   ControllerGains gains_;
@@ -194,6 +197,9 @@ class TrajectoryController {
   Vec3 ref_rates_ = Vec3::Zero();
   // Actuator positions the nominal servos can have reached (rate limits).
   vehicle::Controls actuator_estimate_;
+  // Disk tilt the nominal rotor has reached (rad, flapping lag).
+  bool flap_started_ = false;
+  double flap_lon_ = 0, flap_lat_ = 0;
   // Error-dynamics weights e^T P B per axis: position/attitude and rate terms.
   Vec3 outer_p12_, outer_p22_, inner_p12_, inner_p22_;
 };
