@@ -134,14 +134,16 @@ def tail(text, lines=8):
     return "\n".join((text or "").strip().splitlines()[-lines:])
 
 
-def run_lockstep(build, scenario, out_dir, config_dir=DEFAULT_CONFIG, timeout=LOCKSTEP_TIMEOUT_S):
-    """Fly one scenario in the lockstep runner. Returns a record with the
-    summary (None when the runner left none) and, if it broke, an error text."""
+def run_lockstep(build, scenario, out_dir, config_dir=DEFAULT_CONFIG, timeout=LOCKSTEP_TIMEOUT_S,
+                 extra_args=()):
+    """Fly one scenario in the lockstep runner (`extra_args` appended to its
+    command). Returns a record with the summary (None when the runner left
+    none) and, if it broke, an error text."""
     if os.path.isdir(out_dir):
         shutil.rmtree(out_dir)  # a stale summary must never stand in for this flight's
     os.makedirs(out_dir)
     cmd = [bin_path(build, "ofn_sim_runner"), "--scenario", scenario, "--config-dir", config_dir,
-           "--out", out_dir, "--quiet"]
+           "--out", out_dir, "--quiet"] + list(extra_args)
     t0 = time.monotonic()
     rec = {"dir": out_dir, "scenario": scenario, "command": cmd, "exit_code": None, "error": None}
     try:

@@ -106,12 +106,22 @@ def rerun_commands(args, seed):
         else " --template " + os.path.abspath(args.template)
     dense = " --dense" if args.dense else ""
     name = field_name(args, seed)
-    one = "%s --build %s --config-dir %s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
-        me, args.build, args.config_dir, tpl, dense, seed, name)
-    two = ("%s%s --seed %d%s --out /tmp/%s.yaml && %s --scenario /tmp/%s.yaml --config-dir %s "
+    loss = " --link-loss %g" % args.link_loss if args.link_loss > 0 else ""
+    one = "%s --build %s --config-dir %s%s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
+        me, args.build, args.config_dir, tpl, dense, loss, seed, name)
+    two = ("%s%s --seed %d%s --out /tmp/%s.yaml && %s --scenario /tmp/%s.yaml --config-dir %s%s "
            "--out /tmp/%s" % (gen, dense, seed, tpl, name, campaign.bin_path(args.build, "ofn_sim_runner"),
-                              name, args.config_dir, name))
+                              name, args.config_dir, " ".join([""] + runner_link_args(args, seed)),
+                              name))
     return one, two
+
+
+def runner_link_args(args, seed):
+    """The runner's lossy-link options for a field: its seed draws the losses."""
+    if args.link_loss <= 0:
+        return []
+    return ["--link-loss", "%g" % args.link_loss, "--link-seed", str(seed),
+            "--process-table", os.path.join(REPO, "deploy", "processes.yaml")]
 
 
 def field_name(args, seed):
@@ -152,7 +162,8 @@ def fly_field(args, seed, template):
     field = os.path.join(args.out, "fields", field_name(args, seed) + ".yaml")
     obstacles = random_field.write_field(seed, field, template, args.dense)
     run_dir = os.path.join(args.out, "runs", "seed-%d" % seed)
-    rec = campaign.run_lockstep(args.build, field, run_dir, args.config_dir)
+    rec = campaign.run_lockstep(args.build, field, run_dir, args.config_dir,
+                                extra_args=runner_link_args(args, seed))
     base = campaign.run_baseline(args.build, field, args.baseline_cache)
     s = rec.get("summary") or {}
     rs = s.get("clearance_required")
@@ -263,6 +274,9 @@ def write_report(args, runs, ctx):
         "- fields: seeds %s (bench/random_field.py%s, course from %s), %d flown %d at a time"
         % (seeds_text(args.seeds), " --dense" if args.dense else "",
            os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
+        "- link: %s" % ("%g %% of the datagrams between hosts lost (deploy/processes.yaml), "
+                         "drawn from each field's seed" % (100 * args.link_loss)
+                         if args.link_loss > 0 else "no loss"),
         "- wall time: %.0f s in all, %.1f s per field (%.1f s per flight on one core); 1-minute "
         "load average %.1f before, %.1f after" % (ctx["wall_s"], ctx["wall_s"] / max(n, 1),
                                                   sum(r["wall_s"] for r in runs) / max(n, 1),
@@ -279,7 +293,7 @@ def write_report(args, runs, ctx):
     doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
            "mode": "dense" if args.dense else "fair", "runs": n, "outcomes": outcomes,
            "baselines_available": have_baseline, "wall_s": ctx["wall_s"], "load_average": ctx["load"],
-           "seed_base": args.seed_base, "seeds": args.seeds}
+           "seed_base": args.seed_base, "seeds": args.seeds, "link_loss": args.link_loss}
     clear_known = [c for c in clear if c is not None]
     if args.dense:
         routed = [r for r in runs if r["route"] is True]
@@ -439,6 +453,9 @@ def build_parser():
     ap.add_argument("--keep-all", action="store_true",
                     help="keep every run's folder, log included (default: off)")
     ap.add_argument("--quick", action="store_true", help="%d fields (default: off)" % QUICK_RUNS)
+    ap.add_argument("--link-loss", type=float, default=0.0, metavar="P",
+                    help="fly every field over a link that loses this fraction of the datagrams "
+                         "between hosts, e.g. 0.1 (ofn_sim_runner --link-loss; default: 0, no loss)")
     return ap
 
 
@@ -459,6 +476,8 @@ def parse_args(argv):
         args.runs = QUICK_RUNS if args.quick else DEFAULT_RUNS
     if args.runs < 1 or args.jobs < 1:
         ap.error("--runs and --jobs must be >= 1")
+    if not 0.0 <= args.link_loss <= 0.99:
+        ap.error("--link-loss: expected a fraction in [0, 0.99], got %g" % args.link_loss)
     if args.seeds is None:
         args.seeds = list(range(args.seed_base, args.seed_base + args.runs))
     args.build = os.path.abspath(args.build)
