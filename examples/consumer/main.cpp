@@ -1,7 +1,7 @@
 // An outside program using the installed ofn package: it round-trips a
 // NAV_STATE message through LCM's encoding and checks it with ofn_common's
 // validator, plans a global path round a cuboid with the pure global-planner
-// core, and samples a B-spline of the RH optimiser's core. Exit code 0 when
+// core, and samples a B-spline (the flat outputs REF_TRAJ carries). Exit code 0 when
 // every result is as expected.
 
 #include <cmath>
@@ -13,7 +13,7 @@
 #include "ofn/common/validate.hpp"
 #include "ofn/global_planner/global_planner.hpp"
 #include "ofn/nav_state_t.hpp"
-#include "ofn/rh_optimizer/bspline.hpp"
+#include "ofn/common/bspline.hpp"
 
 namespace {
 
@@ -86,11 +86,11 @@ int main() {
          "the planner goes round the cuboid");
 
   // 3. Pure core: a straight cubic B-spline, 10 m in 5 s, is at 5 m halfway.
-  const ofn::rh::BsplineBasis basis(3, 1);
+  const ofn::BsplineBasis basis(3, 1);
   std::vector<ofn::Vec3> control;
   for (int i = 0; i < basis.num_control_points(); ++i)
     control.push_back(ofn::Vec3(10.0 * i / (basis.num_control_points() - 1), 0, -20));
-  const ofn::rh::BsplineTrajectory spline(3, basis.knots(), control, 5.0);
+  const ofn::BsplineTrajectory spline(3, basis.knots(), control, 5.0);
   const ofn::Vec3 middle = spline.position(2.5);
   std::printf("B-spline at t = 2.5 s: (%.3f, %.3f, %.3f)\n", middle.x(), middle.y(), middle.z());
   expect(std::abs(middle.x() - 5.0) < 1e-9, "the B-spline is halfway at half time");

@@ -13,7 +13,7 @@
 #include <Eigen/Dense>
 
 #include "ofn/global_planner/global_planner.hpp"
-#include "ofn/rh_optimizer/bspline.hpp"
+#include "ofn/common/bspline.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 #include "ofn/world/world.hpp"
 
@@ -152,7 +152,7 @@ class Programme {
   int num_variables() const { return 3 * n_ - 9; }
   int num_constraints() const { return kRows * static_cast<int>(s_.size()); }
   int num_control_points() const { return n_; }
-  const rh::BsplineBasis& basis() const { return basis_; }
+  const BsplineBasis& basis() const { return basis_; }
 
   /// Index of control point i's axis in z, -1 when it is fixed.
   int var_index(int i, int axis) const {
@@ -314,11 +314,11 @@ class Programme {
     }
   }
 
-  rh::BsplineTrajectory trajectory(const double* z) const {
+  BsplineTrajectory trajectory(const double* z) const {
     std::vector<Vec3> p;
     Vec3 dp1, dp2;
     control_points(z, p, dp1, dp2);
-    return rh::BsplineTrajectory(basis_.degree(), basis_.knots(), p, duration(z));
+    return BsplineTrajectory(basis_.degree(), basis_.knots(), p, duration(z));
   }
 
  private:
@@ -330,7 +330,7 @@ class Programme {
   }
 
   const Course& course_;
-  rh::BsplineBasis basis_;
+  BsplineBasis basis_;
   double run_up_weight_;
   int n_ = 0;
   std::array<double, 2> r1_{};
@@ -530,7 +530,7 @@ std::string classify_route(const Course& c, const std::vector<TrajectorySample>&
 }
 
 /// First time in [lo, hi] where x(t) reaches x_plane (x(lo) below, x(hi) at or above).
-double crossing_time(const rh::BsplineTrajectory& traj, double x_plane, double lo, double hi) {
+double crossing_time(const BsplineTrajectory& traj, double x_plane, double lo, double hi) {
   for (int it = 0; it < 60 && hi - lo > 1e-9; ++it) {
     const double mid = 0.5 * (lo + hi);
     (traj.position(mid).x() >= x_plane ? hi : lo) = mid;
@@ -549,7 +549,7 @@ struct Verified {
   bool crosses = false;
 };
 
-Verified verify(const Course& c, const rh::BsplineTrajectory& traj, double spacing) {
+Verified verify(const Course& c, const BsplineTrajectory& traj, double spacing) {
   Verified v;
   const double duration = traj.duration();
   const int n = std::max(2, static_cast<int>(std::ceil(duration / spacing)));
@@ -587,7 +587,7 @@ Verified verify(const Course& c, const rh::BsplineTrajectory& traj, double spaci
 
 struct Solved {
   CandidateResult summary;
-  rh::BsplineTrajectory trajectory;
+  BsplineTrajectory trajectory;
   Verified check;
 };
 
@@ -650,7 +650,7 @@ Solved solve_guess(const Course& c, const Guess& guess, const BaselineSettings& 
   return out;
 }
 
-std::vector<TrajectorySample> sample(const rh::BsplineTrajectory& traj, double end,
+std::vector<TrajectorySample> sample(const BsplineTrajectory& traj, double end,
                                      double spacing) {
   std::vector<TrajectorySample> out;
   const int n = std::max(1, static_cast<int>(std::ceil(end / spacing)));

@@ -17,7 +17,7 @@ unset DESTDIR PYTHONPATH
 # 1. Install: copying only.
 env -u DESTDIR cmake --install "$BUILD" --prefix "$PREFIX" > "$WORK/install.txt" 2>&1 ||
   { cat "$WORK/install.txt"; fail "cmake --install failed"; }
-for f in lib/libofn_common.a lib/libofn_bus_auth.a lib/libofn_world.a lib/libofn_rotorcraft_model.a lib/libofn_vehicle_core.a \
+for f in lib/libofn_common.a lib/libofn_bspline.a lib/libofn_bus_auth.a lib/libofn_world.a lib/libofn_rotorcraft_model.a lib/libofn_vehicle_core.a \
          lib/libofn_controller_core.a lib/libofn_sensor_interface_core.a lib/libofn_mapper_core.a \
          lib/libofn_global_planner_core.a lib/libofn_rh_optimizer_core.a lib/libofn_time_optimal.a \
          include/ofn/nav_state_t.hpp include/ofn/common/validate.hpp include/ofn/mapper/mapper.hpp \

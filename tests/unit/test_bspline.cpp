@@ -6,9 +6,9 @@
 #include <random>
 #include <stdexcept>
 
-#include "ofn/rh_optimizer/bspline.hpp"
+#include "ofn/common/bspline.hpp"
 
-namespace ofn::rh {
+namespace ofn {
 namespace {
 
 TEST(BsplineBasis, KnotsAreClampedAndUniform) {
@@ -162,4 +162,4 @@ TEST(BsplineTrajectory, NonUniformKnotsOfLowDegree) {
 }
 
 }  // namespace
-}  // namespace ofn::rh
+}  // namespace ofn

@@ -14,6 +14,7 @@
 #include "ofn/common/clock.hpp"
 #include "ofn/common/logging.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/common/ref_traj_sample.hpp"
 #include "ofn/rh_optimizer/rh_optimizer_service.hpp"
 #include "service_test_bus.hpp"
 
@@ -145,10 +146,14 @@ TEST_F(RhOptimizerServiceTest, AWallAheadEngagesAvoidanceOverIt) {
   for (int i = 0; i < 5; ++i) step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
   ASSERT_TRUE(service_.engaged());
   ASSERT_FALSE(trajs_.empty());
-  const ref_traj_t& t = trajs_.back();
+  ref_traj_t t = trajs_.back();
   EXPECT_EQ(t.mode, ref_traj_t::AVOIDANCE);
-  EXPECT_GE(t.num_samples, 2);
+  // Sent as its B-spline alone (one datagram); sampled as receivers do.
+  EXPECT_EQ(t.num_samples, 0);
   EXPECT_GT(t.num_control_points, 0);
+  EXPECT_LT(t.getEncodedSize(), 1400);
+  expand_ref_traj(t);
+  EXPECT_GE(t.num_samples, 2);
   // It starts on the last plan (the vehicle, held still here, is within
   // replan_position_error of it) and climbs above the wall top plus the
   // clearance by the time it is over the wall.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "ofn/common/ref_traj_sample.hpp"
+
 namespace ofn {
 namespace {
 
@@ -177,16 +179,44 @@ std::string validate(const ref_traj_t& m) {
                            "samples");
       !e.empty())
     return e;
-  if (m.num_samples < 2) return "fewer than two samples";
   if (m.mode < ref_traj_t::NOMINAL || m.mode > ref_traj_t::LOOK_AROUND_LEFT) return "unknown mode";
   const size_t n = m.sample_time.size();
   if (m.position.size() != n || m.velocity.size() != n || m.acceleration.size() != n)
     return "sample arrays differ in length";
-  if (m.num_knots != static_cast<int32_t>(m.knots.size()) ||
-      m.num_control_points != static_cast<int32_t>(m.control_points.size()))
-    return "spline counts do not match";
-  if (m.num_control_points > 0 && m.num_knots != m.num_control_points + m.degree + 1)
-    return "knot count != control points + degree + 1";
+  if (auto e = check_count(m.num_knots, m.knots.size(), MessageLimits::kMaxSplineKnots, "knots");
+      !e.empty())
+    return e;
+  if (auto e = check_count(m.num_control_points, m.control_points.size(),
+                           MessageLimits::kMaxSplineKnots, "control points");
+      !e.empty())
+    return e;
+  if (m.num_control_points > 0) {
+    // A clamped B-spline over [0, T] s from t0, as the RH optimiser sends:
+    // receivers sample it (expand_ref_traj), so it must be one.
+    if (m.degree < 1 || m.degree > 7) return "spline degree outside 1..7";
+    if (m.num_control_points < m.degree + 1) return "fewer control points than degree + 1";
+    if (m.num_knots != m.num_control_points + m.degree + 1)
+      return "knot count != control points + degree + 1";
+    if (!all_finite(m.knots.begin(), m.knots.end())) return "knot not finite";
+    for (size_t i = 1; i < m.knots.size(); ++i)
+      if (m.knots[i] < m.knots[i - 1]) return "knots decrease";
+    const double end = m.knots.back();
+    if (!(end > 0.0) || end > MessageLimits::kMaxTrajSamples * kRefTrajSamplePeriod)
+      return "spline duration outside (0, " +
+             std::to_string(MessageLimits::kMaxTrajSamples * kRefTrajSamplePeriod) + "] s";
+    for (int i = 0; i <= m.degree; ++i)
+      if (m.knots[static_cast<size_t>(i)] != 0.0 || m.knots[m.knots.size() - 1 - i] != end)
+        return "spline not clamped at 0 and its end";
+    for (const auto& p : m.control_points)
+      if (p.size() != 3 || !all_finite(p.begin(), p.end())) return "control point not finite";
+    for (const auto& p : m.control_points)
+      for (double c : p)
+        if (std::abs(c) > MessageLimits::kMaxCoordinate) return "control point out of range";
+  } else if (m.num_knots != 0) {
+    return "knots without control points";
+  }
+  if (n == 0 && m.num_control_points == 0) return "neither samples nor a spline";
+  if (n == 1) return "fewer than two samples";
   if (!all_finite(m.sample_time.begin(), m.sample_time.end())) return "sample time not finite";
   for (size_t i = 1; i < n; ++i)
     if (!(m.sample_time[i] > m.sample_time[i - 1])) return "sample times not increasing";

@@ -281,7 +281,9 @@ void ControllerService::on_mission(const mission_t& m) {
                    m.num_waypoints, m.cruise_speed);
 }
 
-void ControllerService::on_ref_traj(const ref_traj_t& m) {
+void ControllerService::on_ref_traj(ref_traj_t m) {
+  // A plan sent as its spline alone: sampled here, then read like any other.
+  expand_ref_traj(m);
   if (m.mode == ref_traj_t::NOMINAL) {
     ref_traj_.reset();
     selector_.hand_back();

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/ref_traj_sample.hpp"
 
 namespace ofn::rh {
 namespace {
@@ -58,7 +59,9 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   c.nav_max_age = r.number_in("nav_max_age", c.nav_max_age, 0.01, 10.0);
   c.grid_max_age = r.number_in("grid_max_age", c.grid_max_age, 0.05, 60.0);
   c.path_max_age = r.number_in("path_max_age", c.path_max_age, 0.1, 600.0);
-  c.sample_period = r.number_in("sample_period", c.sample_period, 0.01, 1.0);
+  c.sample_period = r.number_in("sample_period", c.sample_period, 0.0, 1.0);
+  if (c.sample_period > 0 && c.sample_period < 0.01)
+    r.fail("sample_period", "expected 0 (the spline alone) or 0.01 to 1 s");
   c.route_change_distance =
       r.number_in("route_change_distance", c.route_change_distance, 0.1, 1000.0);
   c.field_period = r.number_in("field_period", c.field_period, 0.0, 10.0);
@@ -202,18 +205,8 @@ ref_traj_t trajectory_message(const BsplineTrajectory& trajectory, Utime t0, int
   for (const auto& p : trajectory.control_points())
     m.control_points.push_back({p.x(), p.y(), p.z()});
   m.num_control_points = static_cast<int32_t>(m.control_points.size());
-  const double duration = trajectory.duration();
-  const int n = std::max(2, static_cast<int>(std::ceil(duration / period - 1e-9)) + 1);
-  for (int i = 0; i < n; ++i) {
-    const double t = std::min(duration, i * period);
-    if (!m.sample_time.empty() && !(t > m.sample_time.back())) break;
-    const Vec3 p = trajectory.position(t), v = trajectory.velocity(t),
-               a = trajectory.acceleration(t);
-    m.sample_time.push_back(t);
-    m.position.push_back({p.x(), p.y(), p.z()});
-    m.velocity.push_back({v.x(), v.y(), v.z()});
-    m.acceleration.push_back({a.x(), a.y(), a.z()});
-  }
+  // Without samples the plan is one datagram; receivers sample the spline.
+  if (period > 0) set_ref_traj_samples(m, trajectory, period);
   m.num_samples = static_cast<int32_t>(m.sample_time.size());
   return m;
 }
@@ -393,8 +386,9 @@ void RhOptimizerService::publish_nominal(Utime now, const Vec3& position, const 
   m.degree = 0;
   m.num_knots = 0;
   m.num_control_points = 0;
-  m.sample_time = {0.0, config_.sample_period};
-  const Vec3 ahead = position + velocity * config_.sample_period;
+  const double period = config_.sample_period > 0 ? config_.sample_period : kRefTrajSamplePeriod;
+  m.sample_time = {0.0, period};
+  const Vec3 ahead = position + velocity * period;
   m.position = {{position.x(), position.y(), position.z()}, {ahead.x(), ahead.y(), ahead.z()}};
   m.velocity = {{velocity.x(), velocity.y(), velocity.z()},
                 {velocity.x(), velocity.y(), velocity.z()}};

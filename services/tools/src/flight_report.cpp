@@ -16,6 +16,8 @@
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/mission_plan.hpp"
+#include "ofn/common/ref_traj_sample.hpp"
+#include "ofn/common/validate.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/cuboid_list_t.hpp"
 #include "ofn/global_path_t.hpp"
@@ -204,6 +206,8 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
     } else if (channel == channels::kRefTraj) {
       ref_traj_t m{};
       if (!decode(e, m)) return false;
+      // A plan sent as its spline alone is tabled as its receivers sample it.
+      if (validate(m).empty()) expand_ref_traj(m);
       if (m.mode != ref_traj_t::NOMINAL && ref_seen++ % kRefTrajStride == 0) {
         for (size_t i = 0; i < m.sample_time.size(); ++i)
           ref_csv << rel(m.utime) << "," << ref_seq << "," << static_cast<int>(m.mode) << ","

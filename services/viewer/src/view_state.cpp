@@ -200,6 +200,7 @@ std::string ViewState::on_control_status(const control_status_t& msg) {
 std::string ViewState::on_ref_traj(const ref_traj_t& msg) {
   if (auto why = accept(channels::kRefTraj, msg, msg.utime, last_ref_); !why.empty()) return why;
   ref_traj_ = msg;
+  expand_ref_traj(*ref_traj_);  // a plan sent as its spline alone
   return "";
 }
 

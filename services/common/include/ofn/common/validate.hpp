@@ -33,6 +33,7 @@ struct MessageLimits {
   static constexpr int kMaxCuboids = 10000;
   static constexpr int kMaxPathPoints = 10000;
   static constexpr int kMaxTrajSamples = 20000;
+  static constexpr int kMaxSplineKnots = 1000;
   /// Positions farther than this from the origin are not from this mission.
   static constexpr double kMaxCoordinate = 1.0e6;
 };

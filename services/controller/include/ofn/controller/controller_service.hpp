@@ -61,7 +61,7 @@ class ControllerService {
   // A NOMINAL trajectory hands back to waypoint guidance. Avoidance, a kept
   // previous plan and braking override it (paper 2.1), if they start on the
   // reference flown now or on the vehicle.
-  void on_ref_traj(const ref_traj_t& m);
+  void on_ref_traj(ref_traj_t m);
   void on_lidar_scan();
   /// The mission's limits; the airframe's before any mission.
   Limits flight_limits() const;

@@ -15,7 +15,7 @@
 
 #include <Eigen/Dense>
 
-#include "ofn/rh_optimizer/bspline.hpp"
+#include "ofn/common/bspline.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 
 namespace ofn::rh {

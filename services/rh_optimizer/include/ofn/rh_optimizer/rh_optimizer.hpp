@@ -28,7 +28,7 @@
 #include "ofn/common/frames.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/mapper/distance_field.hpp"
-#include "ofn/rh_optimizer/bspline.hpp"
+#include "ofn/common/bspline.hpp"
 
 namespace ofn::rh {
 

@@ -35,7 +35,7 @@ struct RhOptimizerServiceConfig {
   double nav_max_age = 0.5;            // s; older NAV_STATE is stale
   double grid_max_age = 1.0;           // s; older OBSTACLE_GRID is stale: no avoidance decisions
   double path_max_age = 5.0;           // s; an older GLOBAL_PATH is not used as a guess
-  double sample_period = 0.1;          // s between REF_TRAJ samples
+  double sample_period = 0.0;          // s between REF_TRAJ samples; 0: the spline alone
   double route_change_distance = 5.0;  // m a new global path must differ by to be a new route
   double field_period = 0.2;           // s; the distance field is rebuilt at most this often
   double field_altitude_band = 40.0;   // m of altitude above and below the vehicle in the field

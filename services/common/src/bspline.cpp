@@ -1,4 +1,4 @@
-#include "ofn/rh_optimizer/bspline.hpp"
+#include "ofn/common/bspline.hpp"
 
 #include <algorithm>
 #include <array>
@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-namespace ofn::rh {
+namespace ofn {
 namespace {
 
 constexpr int kMaxDegree = 7;
@@ -150,4 +150,4 @@ Vec3 BsplineTrajectory::evaluate(double t, int derivative) const {
   return result * scale;
 }
 
-}  // namespace ofn::rh
+}  // namespace ofn

@@ -11,7 +11,7 @@
 
 #include "ofn/common/frames.hpp"
 
-namespace ofn::rh {
+namespace ofn {
 
 class BsplineBasis {
  public:
@@ -65,4 +65,4 @@ class BsplineTrajectory {
   double duration_ = 0;
 };
 
-}  // namespace ofn::rh
+}  // namespace ofn
