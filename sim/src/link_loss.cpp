@@ -32,6 +32,20 @@ const std::string& LinkLoss::host(const std::string& service) const {
   return found->second;
 }
 
+LinkLoss::~LinkLoss() {
+  if (watched_) watched_->unsubscribe(subscription_);
+}
+
+void LinkLoss::on_message(const lcm::ReceiveBuffer*, const std::string&, LinkLoss* self) {
+  self->next_message();
+}
+
+void LinkLoss::watch(lcm::LCM& lcm) {
+  if (watched_) watched_->unsubscribe(subscription_);
+  watched_ = &lcm;
+  subscription_ = lcm.subscribeFunction(".*", &LinkLoss::on_message, this);
+}
+
 void LinkLoss::published(const std::string& publisher, const std::string& channel) {
   publisher_host_[channel] = host(publisher);
 }
@@ -40,7 +54,10 @@ bool LinkLoss::delivers(const std::string& receiver, const std::string& channel,
                         std::size_t bytes) {
   const auto from = publisher_host_.find(channel);
   // Published by no service (a test's own message): no link to cross.
-  if (from == publisher_host_.end() || from->second == host(receiver)) return true;
+  const std::string& to = host(receiver);
+  if (from == publisher_host_.end() || from->second == to) return true;
+  const auto decided = decided_.find(to);
+  if (decided != decided_.end()) return decided->second;
   ChannelCount& count = counts_[channel];
   ++count.crossing;
   bool arrived = true;
@@ -49,6 +66,7 @@ bool LinkLoss::delivers(const std::string& receiver, const std::string& channel,
   for (std::size_t i = datagrams_for(bytes); i > 0; --i)
     if (uniform_(random_) < config_.datagram_loss) arrived = false;
   if (!arrived) ++count.lost;
+  decided_.emplace(to, arrived);
   return arrived;
 }
 

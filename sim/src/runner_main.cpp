@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
         } catch (const std::out_of_range& e) {
           throw ofn::ConfigError(process_table + ": " + e.what());
         }
+      link->watch(lockstep.lcm());
       ofn::attach_link_model(lockstep.lcm(), link);
     }
     // The services' nodes leave before the handle; the link model with them.

@@ -24,7 +24,10 @@ namespace {
 LinkLossConfig two_hosts(double loss, uint64_t seed = 1) {
   return {loss,
           seed,
-          {{"vehicle_sim", "onboard1"}, {"controller", "onboard1"}, {"mapper", "onboard2"}}};
+          {{"vehicle_sim", "onboard1"},
+           {"controller", "onboard1"},
+           {"mapper", "onboard2"},
+           {"rh_optimizer", "onboard2"}}};
 }
 
 TEST(LinkLoss, FragmentsFollowLcmsFraming) {
@@ -49,7 +52,9 @@ TEST(LinkLoss, BetweenHostsTheLossRateIsThatOfEveryFragmentArriving) {
   constexpr int kDraws = 20000;
   int small = 0, large = 0;
   for (int i = 0; i < kDraws; ++i) {
+    link.next_message();
     small += link.delivers("mapper", "NAV_STATE", 300) ? 1 : 0;
+    link.next_message();
     large += link.delivers("mapper", "SCAN_WORLD", 9600) ? 1 : 0;
   }
   EXPECT_NEAR(small / double(kDraws), 0.9, 0.01);
@@ -59,12 +64,30 @@ TEST(LinkLoss, BetweenHostsTheLossRateIsThatOfEveryFragmentArriving) {
   EXPECT_EQ(link.counts().at("SCAN_WORLD").lost, kDraws - large);
 }
 
+TEST(LinkLoss, TheServicesOfOneHostLoseTheSameMessages) {
+  LinkLoss link(two_hosts(0.5, 11));
+  link.published("vehicle_sim", "SCAN_WORLD");
+  int lost = 0;
+  for (int i = 0; i < 500; ++i) {
+    link.next_message();
+    const bool mapper = link.delivers("mapper", "SCAN_WORLD", 9600);
+    ASSERT_EQ(link.delivers("rh_optimizer", "SCAN_WORLD", 9600), mapper) << i;
+    lost += mapper ? 0 : 1;
+  }
+  EXPECT_GT(lost, 400);  // 1 - 0.5^7 of them
+  // One crossing per message and host, not per service.
+  EXPECT_EQ(link.counts().at("SCAN_WORLD").crossing, 500);
+}
+
 TEST(LinkLoss, TheSameSeedLosesTheSameMessages) {
   auto pattern = [](uint64_t seed) {
     LinkLoss link(two_hosts(0.3, seed));
     link.published("mapper", "CUBOIDS");
     std::vector<bool> got;
-    for (int i = 0; i < 200; ++i) got.push_back(link.delivers("controller", "CUBOIDS", 3000));
+    for (int i = 0; i < 200; ++i) {
+      link.next_message();
+      got.push_back(link.delivers("controller", "CUBOIDS", 3000));
+    }
     return got;
   };
   EXPECT_EQ(pattern(3), pattern(3));
@@ -102,6 +125,7 @@ TEST(LinkLoss, ANodeOnALossyLinkNeverSeesALostMessage) {
   ASSERT_TRUE(lcm.good());
   ManualClock clock(10 * kMicrosPerSecond);
   auto link = std::make_shared<LinkLoss>(two_hosts(0.0));
+  link->watch(lcm);
   attach_link_model(lcm, link);
   Node sender("vehicle_sim", lcm, clock);
   Node same_host("controller", lcm, clock);
@@ -121,21 +145,35 @@ TEST(LinkLoss, ANodeOnALossyLinkNeverSeesALostMessage) {
   EXPECT_EQ(link->counts().at("NAV_STATE").crossing, 1);
   detach_link_model(lcm);
 
-  // The same with every datagram between hosts lost.
+  // The same with half the datagrams between hosts lost.
   lcm::LCM lossy("memq://");
-  auto all_lost = std::make_shared<LinkLoss>(two_hosts(0.99));
+  auto all_lost = std::make_shared<LinkLoss>(two_hosts(0.5, 5));
+  all_lost->watch(lossy);
   attach_link_model(lossy, all_lost);
   Node sender2("vehicle_sim", lossy, clock);
   Node same2("controller", lossy, clock);
   Node other2("mapper", lossy, clock);
+  Node other3("rh_optimizer", lossy, clock);
   int got_same = 0, got_other = 0;
+  std::vector<int64_t> by_mapper, by_optimizer;
   same2.subscribe<nav_state_t>("NAV_STATE", [&](const nav_state_t&) { ++got_same; });
-  other2.subscribe<nav_state_t>("NAV_STATE", [&](const nav_state_t&) { ++got_other; });
-  for (int i = 0; i < 50; ++i) sender2.publish("NAV_STATE", m);
+  other2.subscribe<nav_state_t>("NAV_STATE", [&](const nav_state_t& n) {
+    ++got_other;
+    by_mapper.push_back(n.utime);
+  });
+  other3.subscribe<nav_state_t>("NAV_STATE",
+                                [&](const nav_state_t& n) { by_optimizer.push_back(n.utime); });
+  for (int i = 0; i < 50; ++i) {
+    m.utime = clock.now() - i;
+    sender2.publish("NAV_STATE", m);
+  }
   while (lossy.handleTimeout(0) > 0) {
   }
   EXPECT_EQ(got_same, 50);
-  EXPECT_LE(got_other, 5);  // 1 % of 50 expected
+  EXPECT_GT(got_other, 10);  // half of 50 expected
+  EXPECT_LT(got_other, 40);
+  // The two services of the other host got the same messages.
+  EXPECT_EQ(by_mapper, by_optimizer);
   // A lost message was never received: it is not counted as rejected.
   EXPECT_EQ(other2.counters().rejected, 0);
   EXPECT_EQ(other2.counters().received, got_other);

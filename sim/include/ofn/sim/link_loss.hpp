@@ -8,15 +8,18 @@
 // LCM sends a message of more than kShortMessageMax bytes as fragments of
 // kFragmentPayload bytes, and a message is lost when any fragment is: a
 // 9.6 KB scan is 7 datagrams and is lost 52 % of the time at 10 % loss.
-// Each receiving service draws on its own (a host's services share one
-// datagram in reality; drawing apart makes their views of the bus differ
-// more, not less). Services on one host never lose a message.
+// The services of one host share the draw (the datagrams are lost on the
+// link, before the host), so the mapper and the RH optimiser on onboard2
+// see the same scans; services on one host never lose a message between
+// them.
 
 #include <cstddef>
 #include <cstdint>
 #include <map>
 #include <random>
 #include <string>
+
+#include <lcm/lcm-cpp.hpp>
 
 #include "ofn/common/link_model.hpp"
 
@@ -43,12 +46,23 @@ class LinkLoss : public LinkModel {
  public:
   /// Throws std::invalid_argument for a probability outside [0, 1).
   explicit LinkLoss(LinkLossConfig config);
+  ~LinkLoss() override;
+  LinkLoss(const LinkLoss&) = delete;
+  LinkLoss& operator=(const LinkLoss&) = delete;
+
+  /// Subscribes to every channel of `lcm` to learn where one message ends
+  /// and the next begins; call before any service subscribes, so that
+  /// LCM hands each message to this first. `lcm` must outlive this.
+  void watch(lcm::LCM& lcm);
+  /// The message now being delivered is a new one: hosts draw afresh.
+  void next_message() { decided_.clear(); }
 
   void published(const std::string& publisher, const std::string& channel) override;
   bool delivers(const std::string& receiver, const std::string& channel,
                 std::size_t bytes) override;
 
-  /// Messages that crossed between hosts, and of those the lost, per channel.
+  /// Messages that crossed to another host, and of those the lost, per
+  /// channel (a message reaching two hosts counts twice).
   struct ChannelCount {
     std::int64_t crossing = 0;
     std::int64_t lost = 0;
@@ -65,6 +79,12 @@ class LinkLoss : public LinkModel {
   // Each channel has one publisher; a heartbeat channel its own service.
   std::map<std::string, std::string> publisher_host_;
   std::map<std::string, ChannelCount> counts_;
+  // Whether the message now being delivered reached each receiving host.
+  std::map<std::string, bool> decided_;
+  lcm::LCM* watched_ = nullptr;
+  lcm::Subscription* subscription_ = nullptr;
+
+  static void on_message(const lcm::ReceiveBuffer*, const std::string&, LinkLoss* self);
 };
 
 }  // namespace ofn::sim
