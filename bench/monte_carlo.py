@@ -106,7 +106,9 @@ def rerun_commands(args, seed):
         else " --template " + os.path.abspath(args.template)
     dense = " --dense" if args.dense else ""
     name = field_name(args, seed)
-    loss = " --link-loss %g" % args.link_loss if args.link_loss > 0 else ""
+    loss = "".join(" --%s %g" % (flag, value) for flag, value in
+                   (("link-loss", args.link_loss), ("link-delay", args.link_delay),
+                    ("link-jitter", args.link_jitter)) if value > 0)
     one = "%s --build %s --config-dir %s%s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
         me, args.build, args.config_dir, tpl, dense, loss, seed, name)
     two = ("%s%s --seed %d%s --out /tmp/%s.yaml && %s --scenario /tmp/%s.yaml --config-dir %s%s "
@@ -116,11 +118,16 @@ def rerun_commands(args, seed):
     return one, two
 
 
+def link_faulty(args):
+    return args.link_loss > 0 or args.link_delay > 0 or args.link_jitter > 0
+
+
 def runner_link_args(args, seed):
-    """The runner's lossy-link options for a field: its seed draws the losses."""
-    if args.link_loss <= 0:
+    """The runner's link-fault options for a field: its seed draws the faults."""
+    if not link_faulty(args):
         return []
-    return ["--link-loss", "%g" % args.link_loss, "--link-seed", str(seed),
+    return ["--link-loss", "%g" % args.link_loss, "--link-delay", "%g" % args.link_delay,
+            "--link-jitter", "%g" % args.link_jitter, "--link-seed", str(seed),
             "--process-table", os.path.join(REPO, "deploy", "processes.yaml")]
 
 
@@ -274,9 +281,10 @@ def write_report(args, runs, ctx):
         "- fields: seeds %s (bench/random_field.py%s, course from %s), %d flown %d at a time"
         % (seeds_text(args.seeds), " --dense" if args.dense else "",
            os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
-        "- link: %s" % ("%g %% of the datagrams between hosts lost (deploy/processes.yaml), "
-                         "drawn from each field's seed" % (100 * args.link_loss)
-                         if args.link_loss > 0 else "no loss"),
+        "- link: %s" % ("between hosts (deploy/processes.yaml), %g %% of the datagrams lost, "
+                         "every message %g +- %g s late, drawn from each field's seed"
+                         % (100 * args.link_loss, args.link_delay, args.link_jitter)
+                         if link_faulty(args) else "no faults"),
         "- wall time: %.0f s in all, %.1f s per field (%.1f s per flight on one core); 1-minute "
         "load average %.1f before, %.1f after" % (ctx["wall_s"], ctx["wall_s"] / max(n, 1),
                                                   sum(r["wall_s"] for r in runs) / max(n, 1),
@@ -293,7 +301,8 @@ def write_report(args, runs, ctx):
     doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
            "mode": "dense" if args.dense else "fair", "runs": n, "outcomes": outcomes,
            "baselines_available": have_baseline, "wall_s": ctx["wall_s"], "load_average": ctx["load"],
-           "seed_base": args.seed_base, "seeds": args.seeds, "link_loss": args.link_loss}
+           "seed_base": args.seed_base, "seeds": args.seeds, "link_loss": args.link_loss,
+           "link_delay": args.link_delay, "link_jitter": args.link_jitter}
     clear_known = [c for c in clear if c is not None]
     if args.dense:
         routed = [r for r in runs if r["route"] is True]
@@ -456,6 +465,10 @@ def build_parser():
     ap.add_argument("--link-loss", type=float, default=0.0, metavar="P",
                     help="fly every field over a link that loses this fraction of the datagrams "
                          "between hosts, e.g. 0.1 (ofn_sim_runner --link-loss; default: 0, no loss)")
+    ap.add_argument("--link-delay", type=float, default=0.0, metavar="S",
+                    help="and delay every message between hosts by S seconds (default: 0)")
+    ap.add_argument("--link-jitter", type=float, default=0.0, metavar="S",
+                    help="give that delay a uniform +-S jitter (default: 0)")
     return ap
 
 
@@ -478,6 +491,9 @@ def parse_args(argv):
         ap.error("--runs and --jobs must be >= 1")
     if not 0.0 <= args.link_loss <= 0.99:
         ap.error("--link-loss: expected a fraction in [0, 0.99], got %g" % args.link_loss)
+    for flag, value in (("--link-delay", args.link_delay), ("--link-jitter", args.link_jitter)):
+        if not 0.0 <= value <= 10.0:
+            ap.error("%s: expected 0 to 10 s, got %g" % (flag, value))
     if args.seeds is None:
         args.seeds = list(range(args.seed_base, args.seed_base + args.runs))
     args.build = os.path.abspath(args.build)

@@ -21,7 +21,7 @@
 #include "ofn/obstacle_injector/obstacle_injector_service.hpp"
 #include "ofn/rh_optimizer/rh_optimizer_service.hpp"
 #include "ofn/sensor_interface/sensor_interface_service.hpp"
-#include "ofn/sim/link_loss.hpp"
+#include "ofn/sim/link_faults.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/tools/flight_report.hpp"
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
@@ -41,9 +41,9 @@ int main(int argc, char** argv) {
   CLI::App app{"ofn lockstep runner: all services in one process, deterministic and fast"};
   std::string scenario_path, config_dir = "config", out_dir, log_path, log_level = "warn";
   std::string process_table = "deploy/processes.yaml";
-  double max_time = 0, linger = 2.0, link_loss = 0.0;
+  double max_time = 0, linger = 2.0, link_loss = 0.0, link_delay = 0.0, link_jitter = 0.0;
   uint64_t link_seed = 1;
-  bool quiet = false, no_avoidance = false;
+  bool quiet = false, no_avoidance = false, link_all = false;
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -61,9 +61,17 @@ int main(int argc, char** argv) {
                  "probability that a datagram between two hosts is lost (hosts from "
                  "--process-table; a message is lost when any of its fragments is)")
       ->check(CLI::Range(0.0, 0.99));
-  app.add_option("--link-seed", link_seed, "seed of the link-loss draws")->capture_default_str();
+  app.add_option("--link-delay", link_delay, "s every message between two hosts is delayed")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--link-jitter", link_jitter,
+                 "s of uniform jitter (+-) on that delay; messages then overtake one another")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_flag("--link-all", link_all,
+               "the link faults also between the services of one host (the controller-vehicle "
+               "loop included)");
+  app.add_option("--link-seed", link_seed, "seed of the link-fault draws")->capture_default_str();
   app.add_option("--process-table", process_table,
-                 "process table naming each service's host, for --link-loss")
+                 "process table naming each service's host, for the link faults")
       ->capture_default_str();
   app.add_flag("--quiet", quiet, "no progress lines");
   app.add_flag("--no-avoidance", no_avoidance,
@@ -101,10 +109,11 @@ int main(int argc, char** argv) {
 
     ofn::sim::Lockstep lockstep;
     if (!log_path.empty()) lockstep.record(log_path);
-    std::shared_ptr<ofn::sim::LinkLoss> link;
-    if (link_loss > 0) {
-      link = std::make_shared<ofn::sim::LinkLoss>(ofn::sim::LinkLossConfig{
-          link_loss, link_seed, ofn::sim::load_service_hosts(process_table)});
+    std::shared_ptr<ofn::sim::LinkFaults> link;
+    if (link_loss > 0 || link_delay > 0 || link_jitter > 0) {
+      link = std::make_shared<ofn::sim::LinkFaults>(
+          ofn::sim::LinkFaultsConfig{link_loss, link_delay, link_jitter, link_all, link_seed,
+                                     ofn::sim::load_service_hosts(process_table)});
       // Every service must have a host before the first message crosses.
       for (const char* service :
            {"vehicle_sim", "mission_uplink", "controller", "obstacle_injector", "sensor_interface",
@@ -175,9 +184,12 @@ int main(int argc, char** argv) {
           by_channel += " " + channel + " " + std::to_string(count.lost) + "/" +
                         std::to_string(count.crossing);
       }
-      std::printf("link loss %.0f %% per datagram: %lld of %lld messages between hosts lost:%s\n",
-                  100.0 * link_loss, static_cast<long long>(lost), static_cast<long long>(crossing),
-                  by_channel.c_str());
+      // One line, "N of M messages ... lost", that scripts read.
+      std::printf(
+          "link faults (%.0f %% of datagrams lost, delay %.3f +- %.3f s, %s): %lld of %lld "
+          "messages lost:%s\n",
+          100.0 * link_loss, link_delay, link_jitter, link_all ? "every link" : "between hosts",
+          static_cast<long long>(lost), static_cast<long long>(crossing), by_channel.c_str());
     }
 
     if (!out_dir.empty()) {

@@ -12,8 +12,8 @@
 
 #include <Eigen/Dense>
 
-#include "ofn/global_planner/global_planner.hpp"
 #include "ofn/common/bspline.hpp"
+#include "ofn/global_planner/global_planner.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 #include "ofn/world/world.hpp"
 
@@ -650,8 +650,7 @@ Solved solve_guess(const Course& c, const Guess& guess, const BaselineSettings& 
   return out;
 }
 
-std::vector<TrajectorySample> sample(const BsplineTrajectory& traj, double end,
-                                     double spacing) {
+std::vector<TrajectorySample> sample(const BsplineTrajectory& traj, double end, double spacing) {
   std::vector<TrajectorySample> out;
   const int n = std::max(1, static_cast<int>(std::ceil(end / spacing)));
   for (int k = 0; k <= n; ++k) {

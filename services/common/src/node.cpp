@@ -92,10 +92,38 @@ Node::~Node() {
     if (sub->handle) lcm_.unsubscribe(sub->handle);
 }
 
-void Node::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscription* sub) {
+void Node::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Subscription* sub) {
+  Node& node = *sub->node;
+  if (node.link_) {
+    // A simulated link: the message may never arrive, or arrive later.
+    const auto fate = node.link_->deliver(node.name_, channel, rbuf->data_size);
+    if (!fate.arrives) return;
+    if (fate.delay > 0.0 && node.clock_.valid()) {
+      const auto* bytes = static_cast<const uint8_t*>(rbuf->data);
+      HeldMessage held{node.clock_.now() + to_utime(fate.delay), node.held_count_++, sub,
+                       std::vector<uint8_t>(bytes, bytes + rbuf->data_size)};
+      const auto at = std::upper_bound(node.held_.begin(), node.held_.end(), held,
+                                       [](const HeldMessage& a, const HeldMessage& b) {
+                                         return a.due != b.due ? a.due < b.due : a.order < b.order;
+                                       });
+      node.held_.insert(at, std::move(held));
+      return;
+    }
+  }
   const auto begin = std::chrono::steady_clock::now();
   sub->deliver(rbuf);
-  sub->node->account_work(std::chrono::steady_clock::now() - begin);
+  node.account_work(std::chrono::steady_clock::now() - begin);
+}
+
+void Node::deliver_held(Utime now) {
+  while (!held_.empty() && held_.front().due <= now) {
+    HeldMessage m = std::move(held_.front());
+    held_.erase(held_.begin());
+    lcm::ReceiveBuffer rbuf{m.bytes.data(), static_cast<uint32_t>(m.bytes.size()), now};
+    const auto begin = std::chrono::steady_clock::now();
+    m.sub->deliver(&rbuf);
+    account_work(std::chrono::steady_clock::now() - begin);
+  }
 }
 
 void Node::add_subscription(std::unique_ptr<Subscription> sub) {
@@ -182,7 +210,7 @@ void Node::add_timer(double period, std::function<void()> callback, std::string 
 }
 
 Utime Node::next_deadline() const {
-  Utime next = INT64_MAX;
+  Utime next = held_.empty() ? INT64_MAX : held_.front().due;
   // An unscheduled timer (INT64_MIN) is due at once.
   for (const auto& t : timers_) next = std::min(next, t.deadline);
   return next;
@@ -190,6 +218,7 @@ Utime Node::next_deadline() const {
 
 void Node::fire_due_timers(Utime now, int max_catch_up) {
   if (!clock_.valid()) return;
+  deliver_held(now);
   if (start_time_ == INT64_MIN) start_time_ = now;
   for (auto& t : timers_) {
     if (t.deadline == INT64_MIN) {

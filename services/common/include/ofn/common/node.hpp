@@ -77,8 +77,6 @@ class Node {
     sub->channel = channel;
     sub->deliver = [this, handler = std::move(handler), options,
                     channel](const lcm::ReceiveBuffer* rbuf) {
-      // A message the simulated link loses never reached this service.
-      if (link_ && !link_->delivers(name_, channel, rbuf->data_size)) return;
       size_t payload_size = rbuf->data_size;
       if (auth_) {
         const auto opened = auth_->open(channel, rbuf->data, rbuf->data_size);
@@ -133,9 +131,11 @@ class Node {
   /// tick of the node's clock that is a whole multiple of the period.
   void add_timer(double period, std::function<void()> callback, std::string label);
 
-  /// Earliest timer deadline (clock time); INT64_MAX when there is none.
+  /// Earliest timer deadline, or arrival of a message a simulated link
+  /// holds back (clock time); INT64_MAX when there is none.
   Utime next_deadline() const;
-  /// Runs every timer due at or before `now`. A timer that fell more than
+  /// Hands over the messages a simulated link held back until now, then
+  /// runs every timer due at or before `now`. A timer that fell more than
   /// `max_catch_up` periods behind skips ahead and counts an overrun.
   void fire_due_timers(Utime now, int max_catch_up = 1000);
   /// Schedules every timer afresh from the next clock tick, as at start: for
@@ -164,7 +164,16 @@ class Node {
     int64_t overruns = 0;
   };
 
+  // A message a simulated link delays: its bytes, for whom and when.
+  struct HeldMessage {
+    Utime due;
+    int64_t order;  // arrival order among messages due at the same time
+    Subscription* sub;
+    std::vector<uint8_t> bytes;
+  };
+
   static void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Subscription* sub);
+  void deliver_held(Utime now);
   void add_subscription(std::unique_ptr<Subscription> sub);
   bool check_time(const std::string& channel, Utime stamp, const SubscribeOptions& options);
   void publish_heartbeat();
@@ -175,6 +184,8 @@ class Node {
   const Clock& clock_;
   std::shared_ptr<bus_auth::Authenticator> auth_;
   std::shared_ptr<LinkModel> link_;
+  std::vector<HeldMessage> held_;  // by due time, then order
+  int64_t held_count_ = 0;
   std::vector<uint8_t> publish_buffer_;
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;

@@ -1,17 +1,21 @@
 #pragma once
-// Packet loss between hosts, for the lockstep runner: the three-host split
-// of deploy/processes.yaml flown in one process, with every datagram that
-// crosses from one host to another dropped with a given probability. The
-// draws come from a seeded generator in delivery order, so a lossy lockstep
-// flight repeats to the bit, like a loss-free one.
+// A bad network for the lockstep runner: the three-host split of
+// deploy/processes.yaml flown in one process, with every message that
+// crosses from one host to another lost with the loss of any of its
+// datagrams, and delayed by a fixed time plus a uniform jitter (so that
+// messages also overtake one another). The draws come from a seeded
+// generator in delivery order, so a faulty lockstep flight repeats to the
+// bit, like a clean one.
 //
 // LCM sends a message of more than kShortMessageMax bytes as fragments of
 // kFragmentPayload bytes, and a message is lost when any fragment is: a
 // 9.6 KB scan is 7 datagrams and is lost 52 % of the time at 10 % loss.
-// The services of one host share the draw (the datagrams are lost on the
-// link, before the host), so the mapper and the RH optimiser on onboard2
-// see the same scans; services on one host never lose a message between
-// them.
+// The services of one host share each message's fate (the datagrams are
+// lost and held on the link, before the host), so the mapper and the RH
+// optimiser on onboard2 see the same scans at the same time. Between the
+// services of one host nothing happens unless `all_links` is set (the bus
+// of one computer is not the radio between two, but a test may want the
+// controller-vehicle loop delayed too).
 
 #include <cstddef>
 #include <cstdint>
@@ -36,19 +40,23 @@ std::size_t datagrams_for(std::size_t bytes);
 /// deploy/processes.yaml (name -> host). Throws ConfigError when unreadable.
 std::map<std::string, std::string> load_service_hosts(const std::string& process_table);
 
-struct LinkLossConfig {
+struct LinkFaultsConfig {
   double datagram_loss = 0.0;  // probability, [0, 1)
+  double delay = 0.0;          // s, every message
+  double jitter = 0.0;         // s, uniform +- on top of the delay (never below 0)
+  bool all_links = false;      // also between the services of one host
   std::uint64_t seed = 1;
   std::map<std::string, std::string> host_of;  // service -> host
 };
 
-class LinkLoss : public LinkModel {
+class LinkFaults : public LinkModel {
  public:
-  /// Throws std::invalid_argument for a probability outside [0, 1).
-  explicit LinkLoss(LinkLossConfig config);
-  ~LinkLoss() override;
-  LinkLoss(const LinkLoss&) = delete;
-  LinkLoss& operator=(const LinkLoss&) = delete;
+  /// Throws std::invalid_argument for a probability outside [0, 1) or a
+  /// negative or non-finite delay or jitter.
+  explicit LinkFaults(LinkFaultsConfig config);
+  ~LinkFaults() override;
+  LinkFaults(const LinkFaults&) = delete;
+  LinkFaults& operator=(const LinkFaults&) = delete;
 
   /// Subscribes to every channel of `lcm` to learn where one message ends
   /// and the next begins; call before any service subscribes, so that
@@ -58,10 +66,10 @@ class LinkLoss : public LinkModel {
   void next_message() { decided_.clear(); }
 
   void published(const std::string& publisher, const std::string& channel) override;
-  bool delivers(const std::string& receiver, const std::string& channel,
-                std::size_t bytes) override;
+  Delivery deliver(const std::string& receiver, const std::string& channel,
+                   std::size_t bytes) override;
 
-  /// Messages that crossed to another host, and of those the lost, per
+  /// Messages that crossed a faulty link, and of those the lost, per
   /// channel (a message reaching two hosts counts twice).
   struct ChannelCount {
     std::int64_t crossing = 0;
@@ -73,18 +81,19 @@ class LinkLoss : public LinkModel {
   const std::string& host(const std::string& service) const;
 
  private:
-  LinkLossConfig config_;
+  LinkFaultsConfig config_;
   std::mt19937_64 random_;
   std::uniform_real_distribution<double> uniform_{0.0, 1.0};
   // Each channel has one publisher; a heartbeat channel its own service.
-  std::map<std::string, std::string> publisher_host_;
+  std::map<std::string, std::string> publisher_;
   std::map<std::string, ChannelCount> counts_;
-  // Whether the message now being delivered reached each receiving host.
-  std::map<std::string, bool> decided_;
+  // The fate of the message now being delivered, per receiving host (per
+  // service with all_links: each then has its own link).
+  std::map<std::string, Delivery> decided_;
   lcm::LCM* watched_ = nullptr;
   lcm::Subscription* subscription_ = nullptr;
 
-  static void on_message(const lcm::ReceiveBuffer*, const std::string&, LinkLoss* self);
+  static void on_message(const lcm::ReceiveBuffer*, const std::string&, LinkFaults* self);
 };
 
 }  // namespace ofn::sim
