@@ -173,6 +173,16 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   w.handback_hold = a.number_in("handback_hold", w.handback_hold, 0.0, 60.0);
   w.handback_stop_speed = a.number_in("handback_stop_speed", w.handback_stop_speed, 0.0, 100.0);
   a.finish();
+  YamlReader sc = r.child("scan_supply");
+  ScanSupplySettings& u = c.scan_supply;
+  u.enabled = sc.boolean("enabled", u.enabled);
+  u.window = sc.number_in("window", u.window, 0.5, 60.0);
+  u.starved_below = sc.number_in("starved_below", u.starved_below, 0.0, 1.0);
+  u.fed_above = sc.number_in("fed_above", u.fed_above, u.starved_below, 1.0);
+  u.max_silence = sc.number_in("max_silence", u.max_silence, 0.1, 60.0);
+  u.min_expected = sc.integer("min_expected", u.min_expected);
+  if (u.min_expected < 1 || u.min_expected > 10000) sc.fail("min_expected", "expected 1..10000");
+  sc.finish();
   r.finish();
   return c;
 }
@@ -229,6 +239,7 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
       planner_(config_.optimizer, config_.fallback, config_.commit),
       switch_(config_.avoidance),
       visibility_(1.0, config_.visibility_band),
+      scan_supply_(config_.scan_supply),
       field_(config_.field),
       recovery_(config_.recovery) {
   node_.subscribe<nav_state_t>(
@@ -315,6 +326,7 @@ void RhOptimizerService::on_global_path(const global_path_t& m) {
 }
 
 void RhOptimizerService::on_scan(const scan_world_t& m) {
+  scan_supply_.received(to_seconds(node_.now()), m.scan_index);
   const Vec3 origin = to_vec3(m.sensor_origin);
   const double altitude = -origin.z();
   for (const auto& p : m.points)
@@ -479,6 +491,23 @@ void RhOptimizerService::tick() {
     // keeps its last trajectory until the controller times it out.
     note("no fresh obstacle grid");
     return publish_stats(now, solver_stats_t::NOT_RUN, "no fresh obstacle grid", nullptr);
+  }
+  // A map fed by a trickle of scans is as blind as none: no plans, and
+  // guidance holds (PerceptionWatch); the controller flies the last plan's
+  // stop.
+  if (scan_supply_.starved(to_seconds(now))) {
+    if (!scans_starved_)
+      node_.log().warn("map starved of scans at t={:.2f} s ({}): no plans until fed again",
+                       to_seconds(now), scan_supply_.why());
+    scans_starved_ = true;
+    note("map starved of scans");
+    return publish_stats(now, solver_stats_t::NOT_RUN,
+                         "map starved of scans: " + scan_supply_.why(), nullptr);
+  }
+  if (scans_starved_) {
+    node_.log().info("map fed again at t={:.2f} s ({:.0f} % of the scans arrive)", to_seconds(now),
+                     100.0 * scan_supply_.share());
+    scans_starved_ = false;
   }
   refresh_field(now, position);
 

@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "ofn/common/braking.hpp"
-#include "ofn/common/scenario.hpp"
 #include "ofn/common/bspline.hpp"
+#include "ofn/common/scenario.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 
 namespace ofn::rh {

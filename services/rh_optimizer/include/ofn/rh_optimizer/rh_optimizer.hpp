@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
+#include "ofn/common/bspline.hpp"
 #include "ofn/common/frames.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/mapper/distance_field.hpp"
-#include "ofn/common/bspline.hpp"
 
 namespace ofn::rh {
 

@@ -25,6 +25,7 @@
 #include "ofn/rh_optimizer/dead_end_recovery.hpp"
 #include "ofn/rh_optimizer/occlusion.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
+#include "ofn/rh_optimizer/scan_supply.hpp"
 #include "ofn/scan_world_t.hpp"
 #include "ofn/solver_stats_t.hpp"
 
@@ -82,7 +83,8 @@ struct RhOptimizerServiceConfig {
   FallbackSettings fallback;
   CommitSettings commit;  // the safety invariant of every published plan
   SwitchSettings avoidance;
-  RecoverySettings recovery;  // out of dead ends
+  RecoverySettings recovery;       // out of dead ends
+  ScanSupplySettings scan_supply;  // no plans on a map starved of scans
 };
 
 /// Reads an rh_optimizer config; unknown fields are errors.
@@ -144,6 +146,8 @@ class RhOptimizerService {
   VisibilityRecord visibility_;
   ShadowMemory shadows_;
   int64_t scans_seen_ = 0;
+  ScanSupply scan_supply_;
+  bool scans_starved_ = false;
   mapping::Heightfield heightfield_;
   // heightfield_ before the shadows: what the unseen extension starts from
   mapping::Heightfield mapped_;
