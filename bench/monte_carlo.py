@@ -464,7 +464,7 @@ def build_parser():
     ap.add_argument("--quick", action="store_true", help="%d fields (default: off)" % QUICK_RUNS)
     ap.add_argument("--link-loss", type=float, default=0.0, metavar="P",
                     help="fly every field over a link that loses this fraction of the datagrams "
-                         "between hosts, e.g. 0.1 (ofn_sim_runner --link-loss; default: 0, no loss)")
+                         "between hosts, e.g. 0.1, as ofn_sim_runner --link-loss (default: 0, no loss)")
     ap.add_argument("--link-delay", type=float, default=0.0, metavar="S",
                     help="and delay every message between hosts by S seconds (default: 0)")
     ap.add_argument("--link-jitter", type=float, default=0.0, metavar="S",
