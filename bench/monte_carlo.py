@@ -106,11 +106,11 @@ def rerun_commands(args, seed):
         else " --template " + os.path.abspath(args.template)
     dense = " --dense" if args.dense else ""
     name = field_name(args, seed)
-    loss = "".join(" --%s %g" % (flag, value) for flag, value in
+    link = "".join(" --%s %g" % (flag, value) for flag, value in
                    (("link-loss", args.link_loss), ("link-delay", args.link_delay),
                     ("link-jitter", args.link_jitter)) if value > 0)
     one = "%s --build %s --config-dir %s%s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
-        me, args.build, args.config_dir, tpl, dense, loss, seed, name)
+        me, args.build, args.config_dir, tpl, dense, link, seed, name)
     two = ("%s%s --seed %d%s --out /tmp/%s.yaml && %s --scenario /tmp/%s.yaml --config-dir %s%s "
            "--out /tmp/%s" % (gen, dense, seed, tpl, name, campaign.bin_path(args.build, "ofn_sim_runner"),
                               name, args.config_dir, " ".join([""] + runner_link_args(args, seed)),

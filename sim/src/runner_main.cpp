@@ -114,15 +114,6 @@ int main(int argc, char** argv) {
       link = std::make_shared<ofn::sim::LinkFaults>(
           ofn::sim::LinkFaultsConfig{link_loss, link_delay, link_jitter, link_all, link_seed,
                                      ofn::sim::load_service_hosts(process_table)});
-      // Every service must have a host before the first message crosses.
-      for (const char* service :
-           {"vehicle_sim", "mission_uplink", "controller", "obstacle_injector", "sensor_interface",
-            "mapper", "global_planner", "rh_optimizer"})
-        try {
-          link->host(service);
-        } catch (const std::out_of_range& e) {
-          throw ofn::ConfigError(process_table + ": " + e.what());
-        }
       link->watch(lockstep.lcm());
       ofn::attach_link_model(lockstep.lcm(), link);
     }
@@ -149,6 +140,14 @@ int main(int argc, char** argv) {
       optimizer.emplace(lockstep.lcm(), lockstep.clock(), optimizer_config);
       lockstep.add(planner->node());
       lockstep.add(optimizer->node());
+    }
+    // Every service must have a host before the first message crosses.
+    for (const ofn::Node* node : link ? lockstep.nodes() : std::vector<ofn::Node*>{}) {
+      try {
+        link->host(node->name());
+      } catch (const std::out_of_range& e) {
+        throw ofn::ConfigError(process_table + ": " + e.what());
+      }
     }
 
     const double limit = max_time > 0 ? max_time : scenario.max_time;

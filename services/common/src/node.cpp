@@ -14,53 +14,57 @@
 namespace ofn {
 namespace {
 
-// The authenticator of each LCM handle: set up once by main() before any
+// What each LCM handle carries for the nodes made on it: set up by main()
+// (an authenticator) or the lockstep runner (a simulated link) before any
 // node exists, read by every node's constructor.
-std::mutex g_authenticators_mutex;
-std::map<const lcm::LCM*, std::shared_ptr<bus_auth::Authenticator>>& authenticators() {
-  static std::map<const lcm::LCM*, std::shared_ptr<bus_auth::Authenticator>> by_handle;
-  return by_handle;
+template <class T>
+class PerHandle {
+ public:
+  void set(const lcm::LCM& lcm, std::shared_ptr<T> value) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    by_handle_[&lcm] = std::move(value);
+  }
+  void erase(const lcm::LCM& lcm) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    by_handle_.erase(&lcm);
+  }
+  std::shared_ptr<T> of(const lcm::LCM& lcm) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto found = by_handle_.find(&lcm);
+    return found == by_handle_.end() ? nullptr : found->second;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<const lcm::LCM*, std::shared_ptr<T>> by_handle_;
+};
+
+PerHandle<bus_auth::Authenticator>& authenticators() {
+  static PerHandle<bus_auth::Authenticator> registry;
+  return registry;
 }
 
-std::shared_ptr<bus_auth::Authenticator> authenticator_of(const lcm::LCM& lcm) {
-  std::lock_guard<std::mutex> lock(g_authenticators_mutex);
-  const auto found = authenticators().find(&lcm);
-  return found == authenticators().end() ? nullptr : found->second;
-}
-
-// The simulated link of each LCM handle (lockstep runs only).
-std::mutex g_links_mutex;
-std::map<const lcm::LCM*, std::shared_ptr<LinkModel>>& links() {
-  static std::map<const lcm::LCM*, std::shared_ptr<LinkModel>> by_handle;
-  return by_handle;
-}
-
-std::shared_ptr<LinkModel> link_of(const lcm::LCM& lcm) {
-  std::lock_guard<std::mutex> lock(g_links_mutex);
-  const auto found = links().find(&lcm);
-  return found == links().end() ? nullptr : found->second;
+PerHandle<LinkModel>& links() {
+  static PerHandle<LinkModel> registry;
+  return registry;
 }
 
 }  // namespace
 
 void attach_link_model(lcm::LCM& lcm, std::shared_ptr<LinkModel> link) {
-  std::lock_guard<std::mutex> lock(g_links_mutex);
-  links()[&lcm] = std::move(link);
+  links().set(lcm, std::move(link));
 }
 
 void detach_link_model(lcm::LCM& lcm) {
-  std::lock_guard<std::mutex> lock(g_links_mutex);
-  links().erase(&lcm);
+  links().erase(lcm);
 }
 
 void attach_authenticator(lcm::LCM& lcm, std::shared_ptr<bus_auth::Authenticator> authenticator) {
-  std::lock_guard<std::mutex> lock(g_authenticators_mutex);
-  authenticators()[&lcm] = std::move(authenticator);
+  authenticators().set(lcm, std::move(authenticator));
 }
 
 void detach_authenticator(lcm::LCM& lcm) {
-  std::lock_guard<std::mutex> lock(g_authenticators_mutex);
-  authenticators().erase(&lcm);
+  authenticators().erase(lcm);
 }
 
 std::string heartbeat_channel(const std::string& service) {
@@ -73,8 +77,8 @@ Node::Node(std::string name, lcm::LCM& lcm, const Clock& clock)
     : name_(std::move(name)),
       lcm_(lcm),
       clock_(clock),
-      auth_(authenticator_of(lcm)),
-      link_(link_of(lcm)),
+      auth_(authenticators().of(lcm)),
+      link_(links().of(lcm)),
       log_(make_logger(name_)),
       period_start_(std::chrono::steady_clock::now()) {
   // A keyring whose policy forgets this service's heartbeat is found at
@@ -100,29 +104,27 @@ void Node::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Su
     if (!fate.arrives) return;
     if (fate.delay > 0.0 && node.clock_.valid()) {
       const auto* bytes = static_cast<const uint8_t*>(rbuf->data);
-      HeldMessage held{node.clock_.now() + to_utime(fate.delay), node.held_count_++, sub,
-                       std::vector<uint8_t>(bytes, bytes + rbuf->data_size)};
-      const auto at = std::upper_bound(node.held_.begin(), node.held_.end(), held,
-                                       [](const HeldMessage& a, const HeldMessage& b) {
-                                         return a.due != b.due ? a.due < b.due : a.order < b.order;
-                                       });
-      node.held_.insert(at, std::move(held));
+      // After those due at the same time: they arrived first.
+      node.held_.emplace(node.clock_.now() + to_utime(fate.delay),
+                         HeldMessage{sub, std::vector<uint8_t>(bytes, bytes + rbuf->data_size)});
       return;
     }
   }
+  node.deliver_now(sub, rbuf);
+}
+
+void Node::deliver_now(Subscription* sub, const lcm::ReceiveBuffer* rbuf) {
   const auto begin = std::chrono::steady_clock::now();
   sub->deliver(rbuf);
-  node.account_work(std::chrono::steady_clock::now() - begin);
+  account_work(std::chrono::steady_clock::now() - begin);
 }
 
 void Node::deliver_held(Utime now) {
-  while (!held_.empty() && held_.front().due <= now) {
-    HeldMessage m = std::move(held_.front());
+  while (!held_.empty() && held_.begin()->first <= now) {
+    HeldMessage m = std::move(held_.begin()->second);
     held_.erase(held_.begin());
     lcm::ReceiveBuffer rbuf{m.bytes.data(), static_cast<uint32_t>(m.bytes.size()), now};
-    const auto begin = std::chrono::steady_clock::now();
-    m.sub->deliver(&rbuf);
-    account_work(std::chrono::steady_clock::now() - begin);
+    deliver_now(m.sub, &rbuf);
   }
 }
 
@@ -210,7 +212,7 @@ void Node::add_timer(double period, std::function<void()> callback, std::string 
 }
 
 Utime Node::next_deadline() const {
-  Utime next = held_.empty() ? INT64_MAX : held_.front().due;
+  Utime next = held_.empty() ? INT64_MAX : held_.begin()->first;
   // An unscheduled timer (INT64_MIN) is due at once.
   for (const auto& t : timers_) next = std::min(next, t.deadline);
   return next;

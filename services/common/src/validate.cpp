@@ -207,11 +207,11 @@ std::string validate(const ref_traj_t& m) {
     for (int i = 0; i <= m.degree; ++i)
       if (m.knots[static_cast<size_t>(i)] != 0.0 || m.knots[m.knots.size() - 1 - i] != end)
         return "spline not clamped at 0 and its end";
-    for (const auto& p : m.control_points)
+    for (const auto& p : m.control_points) {
       if (p.size() != 3 || !all_finite(p.begin(), p.end())) return "control point not finite";
-    for (const auto& p : m.control_points)
       for (double c : p)
         if (std::abs(c) > MessageLimits::kMaxCoordinate) return "control point out of range";
+    }
   } else if (m.num_knots != 0) {
     return "knots without control points";
   }

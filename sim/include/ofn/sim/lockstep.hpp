@@ -23,6 +23,7 @@ class Lockstep {
   ManualClock& clock() { return clock_; }
 
   void add(Node& node) { nodes_.push_back(&node); }
+  const std::vector<Node*>& nodes() const { return nodes_; }
 
   /// Records every message, stamped with clock time, into an LCM log file.
   void record(const std::string& log_path);

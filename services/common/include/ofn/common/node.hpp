@@ -164,15 +164,15 @@ class Node {
     int64_t overruns = 0;
   };
 
-  // A message a simulated link delays: its bytes, for whom and when.
+  // A message a simulated link delays: for whom, and its bytes.
   struct HeldMessage {
-    Utime due;
-    int64_t order;  // arrival order among messages due at the same time
     Subscription* sub;
     std::vector<uint8_t> bytes;
   };
 
   static void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Subscription* sub);
+  /// Hands `rbuf` to the subscription, counting the time it takes as work.
+  void deliver_now(Subscription* sub, const lcm::ReceiveBuffer* rbuf);
   void deliver_held(Utime now);
   void add_subscription(std::unique_ptr<Subscription> sub);
   bool check_time(const std::string& channel, Utime stamp, const SubscribeOptions& options);
@@ -184,8 +184,7 @@ class Node {
   const Clock& clock_;
   std::shared_ptr<bus_auth::Authenticator> auth_;
   std::shared_ptr<LinkModel> link_;
-  std::vector<HeldMessage> held_;  // by due time, then order
-  int64_t held_count_ = 0;
+  std::multimap<Utime, HeldMessage> held_;  // by due time, then arrival
   std::vector<uint8_t> publish_buffer_;
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
