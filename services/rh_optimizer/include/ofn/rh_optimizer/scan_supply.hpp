@@ -41,7 +41,6 @@ class ScanSupply {
   double share() const { return share_; }
   /// Why it is starved, for the log and SOLVER_STATS ("" when fed).
   const std::string& why() const { return why_; }
-  const ScanSupplySettings& settings() const { return settings_; }
 
  private:
   struct Arrival {
