@@ -99,5 +99,15 @@ TEST(ReferenceSelector, TheHoldBeforeAMissionBrakesFromTheVehiclesState) {
   EXPECT_LT(later.velocity.norm(), 1e-12);
 }
 
+TEST(ReferenceSelector, AReferenceLapsesAfterItsLapseTime) {
+  SelectorSettings settings;
+  settings.lapse_time = 0.2;
+  const ReferenceSelector selector(settings);
+  EXPECT_FALSE(selector.lapsed(0.01));  // one control step
+  EXPECT_FALSE(selector.lapsed(0.2));
+  EXPECT_TRUE(selector.lapsed(0.21));
+  EXPECT_TRUE(selector.lapsed(3.0));  // a loop stopped for 3 s
+}
+
 }  // namespace
 }  // namespace ofn::control

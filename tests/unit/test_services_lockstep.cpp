@@ -216,6 +216,7 @@ class NavFeeder {
         0.01, [this] { publish(); }, "nav");
   }
   Node& node() { return node_; }
+  void move_to(const Vec3& position) { position_ = position; }
   bool enabled = true;
   Vec3 velocity = Vec3::Zero();  // reported only; the position stays
 
@@ -315,8 +316,9 @@ TEST_F(LockstepServices, ControllerCommandsLevelHoverWhenNavigationIsLost) {
   EXPECT_EQ(recorder.commands.back().lat_cyclic, 0.0);
 }
 
-/// Uplinks a mission and, from `from` seconds on, a fresh REF_TRAJ every
-/// 0.1 s: a straight line from the vehicle at a constant velocity.
+/// Uplinks a mission (from `missions_from` seconds on) and, from `from`
+/// seconds on, a fresh REF_TRAJ every 0.1 s: a straight line from the
+/// vehicle at a constant velocity.
 class TrajectoryFeeder {
  public:
   TrajectoryFeeder(sim::Lockstep& lockstep, mission_t mission, Vec3 position)
@@ -327,13 +329,15 @@ class TrajectoryFeeder {
         0.1, [this] { publish(); }, "traj");
   }
   Node& node() { return node_; }
+  void move_to(const Vec3& position) { position_ = position; }
   Vec3 velocity = Vec3::Zero();
   double from = 0;
+  double missions_from = 0;
   int8_t mode = ref_traj_t::AVOIDANCE;
 
  private:
   void publish() {
-    node_.publish(channels::kMission, mission_);
+    if (to_seconds(node_.now()) >= missions_from) node_.publish(channels::kMission, mission_);
     if (to_seconds(node_.now()) < from) return;
     ref_traj_t m{};
     m.utime = node_.now();
@@ -513,6 +517,43 @@ std::pair<int8_t, int64_t> fly_mission_only(const mission_t& mission, const Vec3
   return {controller.mode(), rejected_with(controller.node(), text)};
 }
 
+// Navigation lost for 0.5 s (or the control loop stalled) while a plan is
+// flown: the vehicle has flown on without commands, 15 m. The plan, and
+// the plans still made along it, are not chased; the controller stops from
+// the vehicle's state and takes only a plan that starts on the vehicle.
+TEST_F(LockstepServices, AReferenceLapsedIsNotChased) {
+  ControllerFedTrajectories bus(default_controller_config());
+  bus.lockstep.run(to_utime(2.0));
+  ASSERT_EQ(bus.controller.mode(), control_status_t::TRAJECTORY);
+  const Vec3 plan_start = bus.open.waypoints.front().position;
+  const Vec3 drifted = plan_start + Vec3(15, 0, 0);
+  bus.nav.enabled = false;
+  bus.lockstep.run(to_utime(2.5));
+  ASSERT_EQ(bus.controller.mode(), control_status_t::NAV_STALE);
+  bus.nav.move_to(drifted);
+  bus.nav.enabled = true;
+  bus.recorder.status.clear();
+  bus.lockstep.run(to_utime(4.0));
+  ASSERT_FALSE(bus.recorder.status.empty());
+  int stopping = 0;
+  for (const auto& st : bus.recorder.status) {
+    if (st.mode == control_status_t::NAV_STALE) continue;
+    EXPECT_EQ(st.mode, control_status_t::SAFE_STOP) << "at " << to_seconds(st.utime);
+    EXPECT_LT((Vec3(st.ref_position[0], st.ref_position[1], st.ref_position[2]) - drifted).norm(),
+              0.01)
+        << "at " << to_seconds(st.utime);
+    ++stopping;
+  }
+  EXPECT_GE(stopping, 50);
+  EXPECT_GE(rejected_with(bus.controller.node(), "lapsed"), 1);
+  EXPECT_GE(rejected_with(bus.controller.node(), "plan starts off"), 10);
+
+  // A plan restarted at the vehicle is flown.
+  bus.feeder.move_to(drifted);
+  bus.lockstep.run(to_utime(4.5));
+  EXPECT_EQ(bus.controller.mode(), control_status_t::TRAJECTORY);
+}
+
 TEST_F(LockstepServices, AMissionBeyondTheAirframeOrTheFenceIsRefused) {
   const Scenario open = load_scenario(kOpenScenario);
   const Vec3 here = open.waypoints.front().position;
@@ -529,6 +570,84 @@ TEST_F(LockstepServices, AMissionBeyondTheAirframeOrTheFenceIsRefused) {
   const auto [far_mode, far_refusals] = fly_mission_only(far, here, "outside the geofence");
   EXPECT_EQ(far_mode, control_status_t::HOLD);
   EXPECT_GE(far_refusals, 5);
+}
+
+// A simulated vehicle is frozen at its start speed until the controller has
+// a mission, while the hold flown before it moves on along its stop. When
+// the mission came late (lost on a bad link), the flight began from where
+// that reference had got to, metres ahead of the vehicle.
+TEST_F(LockstepServices, ALateMissionBeginsWhereTheVehicleIs) {
+  const Scenario open = load_scenario(kOpenScenario);
+  const Vec3 here = open.waypoints.front().position;
+  sim::Lockstep lockstep;
+  NavFeeder nav(lockstep, here);
+  nav.velocity = Vec3(3.048, 0, 0);  // frozen in trimmed flight
+  TrajectoryFeeder feeder(lockstep, uplink::mission_from_scenario(open, 1), here);
+  feeder.from = 1e9;  // no plans
+  feeder.missions_from = 3.0;
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  BusRecorder recorder(lockstep);
+  for (Node* n : {&nav.node(), &feeder.node(), &controller.node(), &recorder.node()})
+    lockstep.add(*n);
+
+  lockstep.run(to_utime(2.9));
+  ASSERT_FALSE(recorder.status.empty());
+  const control_status_t before = recorder.status.back();
+  EXPECT_EQ(before.mission_id, -1);
+  // The hold's reference has moved on along its stop: the test's premise.
+  EXPECT_GT(before.ref_position[0] - here.x(), 5.0);
+
+  recorder.status.clear();
+  lockstep.run(to_utime(3.3));
+  ASSERT_FALSE(recorder.status.empty());
+  int with_mission = 0;
+  for (const auto& s : recorder.status) {
+    if (s.mission_id != 1) continue;
+    ++with_mission;
+    // At most 0.3 s of flight at the start speed ahead, never behind.
+    EXPECT_GT(s.ref_position[0] - here.x(), -0.01) << "at " << to_seconds(s.utime);
+    EXPECT_LT(s.ref_position[0] - here.x(), 1.0) << "at " << to_seconds(s.utime);
+  }
+  EXPECT_GE(with_mission, 5);
+}
+
+// The simulated vehicle waits, frozen in trimmed flight at its start, for a
+// controller with a mission; then it flies whatever mode that controller is
+// in, a hold for the planner's first word included.
+TEST_F(LockstepServices, VehicleSimIsReleasedByAControllerWithAMission) {
+  sim::Lockstep lockstep;
+  const Scenario open = load_scenario(kOpenScenario);
+  vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), open, default_sim_config());
+  Node controller("controller", lockstep.lcm(), lockstep.clock());
+  int32_t mission_id = -1;
+  controller.add_timer(
+      0.02,
+      [&] {
+        control_status_t s{};
+        s.utime = controller.now();
+        s.mode = control_status_t::HOLD;
+        s.mission_id = mission_id;
+        controller.publish(channels::kControlStatus, s);
+      },
+      "status");
+  std::vector<nav_state_t> nav;
+  controller.subscribe<nav_state_t>(channels::kNavState,
+                                    [&](const nav_state_t& m) { nav.push_back(m); });
+  lockstep.add(vehicle.node());
+  lockstep.add(controller);
+  lockstep.run(to_utime(1.0));
+  ASSERT_GE(nav.size(), 90u);
+  const Vec3 start = open.start_position;
+  for (const auto& m : nav)
+    EXPECT_NEAR(m.position[0], start.x(), 1e-9) << "held at " << to_seconds(m.utime);
+
+  mission_id = 1;
+  nav.clear();
+  lockstep.run(to_utime(2.0));
+  ASSERT_FALSE(nav.empty());
+  // Trimmed at the start speed and commanded nothing else: it flies on.
+  EXPECT_GT(nav.back().position[0] - start.x(), 0.5 * open.start_velocity.x());
 }
 
 TEST_F(LockstepServices, VehicleSimRefusesActuatorCommandsBeyondTheAirframesRange) {

@@ -73,6 +73,14 @@ vehicle::RotorcraftParams read_nominal_airframe(YamlReader& r, vehicle::Rotorcra
   return p;
 }
 
+/// The vehicle's position and velocity as a reference to stop from.
+Reference vehicle_state(const VehicleEstimate& x) {
+  Reference r;
+  r.position = x.position;
+  r.velocity = x.velocity;
+  return r;
+}
+
 }  // namespace
 
 ControllerConfig load_controller_config(YamlReader& r) {
@@ -95,6 +103,7 @@ ControllerConfig load_controller_config(YamlReader& r) {
       selector.number_in("stop_accel_fraction", c.selector.stop_accel_fraction, 0.05, 1.0);
   c.selector.hold_deceleration =
       selector.number_in("hold_deceleration", c.selector.hold_deceleration, 0.01, 20.0);
+  c.selector.lapse_time = selector.number_in("lapse_time", c.selector.lapse_time, 0.02, 10.0);
   selector.finish();
   YamlReader perception = r.child("perception_watch");
   c.perception.enabled = perception.boolean("enabled", c.perception.enabled);
@@ -313,13 +322,13 @@ void ControllerService::on_ref_traj(ref_traj_t m) {
     return;
   }
   std::optional<Reference> flown;
-  const bool flying = last_step_ != INT64_MIN &&
+  const bool flying = last_ref_flown_ && !selector_.lapsed(to_seconds(now - last_flown_step_)) &&
                       (mode_ == control_status_t::TRAJECTORY ||
                        mode_ == control_status_t::WAYPOINT || mode_ == control_status_t::SAFE_STOP);
   if (flying) {
     // The reference of the last step, carried on to now.
     Reference r = last_ref_;
-    r.position += r.velocity * std::max(0.0, to_seconds(now - last_step_));
+    r.position += r.velocity * std::max(0.0, to_seconds(now - last_flown_step_));
     flown = r;
   }
   const Vec3 position = nav_ ? to_vec3(nav_->position) : offered->position;
@@ -411,6 +420,26 @@ void ControllerService::control_step() {
                        config_.nav_prediction);
   if (!path_heading_.initialised()) path_heading_.reset(nav_->euler[2]);
 
+  // A mission's flight begins where the vehicle is: a hold flown before it
+  // (a simulated vehicle is frozen then, in a real one the pilot flies) is
+  // begun again, and a stop flown from the vehicle's state, not from
+  // wherever the earlier reference has got to meanwhile.
+  const bool mission_arrived = mission_pending_;
+  if (mission_arrived) last_ref_flown_ = false;
+  // No reference flown for a while (this loop stalled, or navigation was
+  // lost): the vehicle flew on without commands. Neither the reference nor
+  // a plan made along it is taken up again; a plan must start on the
+  // vehicle, and a stop or guidance starts from its state.
+  const bool lapsed = last_ref_flown_ && selector_.lapsed(to_seconds(now - last_flown_step_));
+  if (lapsed) {
+    node_.log().warn("no reference flown for {:.2f} s: taking over from the vehicle's state",
+                     to_seconds(now - last_flown_step_));
+    node_.reject("reference", "lapsed: taken over from the vehicle's state");
+    last_ref_flown_ = false;
+    ref_traj_.reset();
+    selector_.end_stop();
+    if (guidance_.has_mission()) guidance_.resync(x.position, x.velocity);
+  }
   if (mission_pending_) {
     guidance_.set_mission(waypoints_from(*mission_), mission_->cruise_speed,
                           limits_from(mission_->limits), x.position, x.velocity);
@@ -438,8 +467,8 @@ void ControllerService::control_step() {
     // the flight has not begun, the hold goes on.
     if (guidance_.has_mission() && previous != control_status_t::HOLD)
       node_.log().info("holding for the planner's first status");
-    ref =
-        selector_.hold(to_seconds(now), x.position, x.velocity, previous != control_status_t::HOLD);
+    ref = selector_.hold(to_seconds(now), x.position, x.velocity,
+                         previous != control_status_t::HOLD || mission_arrived || lapsed);
     mode_ = control_status_t::HOLD;
   } else if (traj_ref) {
     mode_ = control_status_t::TRAJECTORY;
@@ -463,7 +492,8 @@ void ControllerService::control_step() {
     if (!selector_.stopping())
       node_.log().warn("avoidance plan stale at t={:.2f} s: flying its stop", to_seconds(now));
     mode_ = control_status_t::SAFE_STOP;
-    ref = selector_.safe_stop(to_seconds(now), last_ref_, mission_->limits.max_accel);
+    ref = selector_.safe_stop(to_seconds(now), last_ref_flown_ ? last_ref_ : vehicle_state(x),
+                              mission_->limits.max_accel);
     facing = facing_along(ref.velocity, config_.heading.min_speed);
   } else if (const auto blind = previous == control_status_t::DONE
                                     ? std::nullopt
@@ -475,13 +505,9 @@ void ControllerService::control_step() {
       node_.log().warn("guidance holds at t={:.2f} s: {}: flying a stop", to_seconds(now), *blind);
     mode_ = control_status_t::SAFE_STOP;
     // From the reference flown, or, with none flown since navigation
-    // returned, from the vehicle's own state.
-    Reference from = last_ref_;
-    if (previous == control_status_t::NAV_STALE || !last_ref_flown_) {
-      from = Reference{};
-      from.position = x.position;
-      from.velocity = x.velocity;
-    }
+    // returned or the mission arrived, from the vehicle's own state.
+    const Reference from =
+        previous == control_status_t::NAV_STALE || !last_ref_flown_ ? vehicle_state(x) : last_ref_;
     ref = selector_.safe_stop(to_seconds(now), from, mission_->limits.max_accel);
     facing = facing_along(ref.velocity, config_.heading.min_speed);
   } else {
@@ -518,6 +544,7 @@ void ControllerService::control_step() {
 
   last_ref_ = ref;
   last_ref_flown_ = true;
+  last_flown_step_ = now;
   last_out_ = controller_.step(ref, x, dt);
   if (!last_out_.valid) node_.reject("control", "non-finite control output replaced by hover");
   cmd.collective = last_out_.controls.collective;

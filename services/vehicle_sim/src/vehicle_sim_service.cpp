@@ -162,12 +162,16 @@ void VehicleSimService::on_command(const actuator_cmd_t& m) {
 
 void VehicleSimService::on_control_status(const control_status_t& m) {
   if (released_) return;
-  // A controller flying a stop (a plan gone stale, or guidance held back
-  // because the planner has not confirmed the way) has the vehicle too.
-  if (m.mode == control_status_t::WAYPOINT || m.mode == control_status_t::TRAJECTORY ||
-      m.mode == control_status_t::SAFE_STOP) {
+  // A controller with a mission flies the vehicle, whatever its mode: held
+  // back for the planner's first word it flies its hold (a stop from the
+  // start speed), and that stop must move the vehicle as it moves the
+  // reference. Released only at WAYPOINT or TRAJECTORY, a late first plan
+  // left the vehicle frozen while the hold's reference drifted up to a
+  // stopping distance ahead, and the first plan then began that far away.
+  if (m.mission_id >= 0) {
     released_ = true;
-    node_.log().info("controller engaged at t={:.2f} s: vehicle released", to_seconds(node_.now()));
+    node_.log().info("controller engaged at t={:.2f} s (mode {}): vehicle released",
+                     to_seconds(node_.now()), static_cast<int>(m.mode));
   }
 }
 

@@ -86,6 +86,7 @@ class ControllerService {
   int active_waypoint_ = -1;
   Reference last_ref_;
   bool last_ref_flown_ = false;
+  Utime last_flown_step_ = INT64_MIN;  // when last_ref_ was flown
   ControlOutput last_out_;
   Utime last_step_ = INT64_MIN;
   Utime last_scan_ = INT64_MIN;

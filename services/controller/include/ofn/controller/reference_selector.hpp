@@ -33,9 +33,14 @@ struct SelectorSettings {
   /// m/s^2 of the hold before any mission (there is no limit yet): a stop
   /// from the vehicle's state rather than a step to zero speed. In the
   /// simulator, which freezes the vehicle in trimmed cruise until the
-  /// controller engages, the command still reaches its bound while the
-  /// stop runs ahead of the frozen vehicle.
+  /// controller has a mission, the command still reaches its bound while
+  /// the stop runs ahead of the frozen vehicle.
   double hold_deceleration = 0.4;
+  /// s without a reference flown (the control loop stalled, navigation was
+  /// lost) after which the reference is not taken up again: the vehicle
+  /// has flown on without commands and the reference, or a plan made along
+  /// it, may be tens of metres away.
+  double lapse_time = 0.2;
 };
 
 class ReferenceSelector {
@@ -61,6 +66,9 @@ class ReferenceSelector {
   }
   /// A stop flown for another reason (guidance held back) has ended.
   void end_stop() { stop_.reset(); }
+  /// No reference has been flown for `gap` seconds: long enough that what
+  /// follows starts from the vehicle's state, not from the reference.
+  bool lapsed(double gap) const { return gap > settings_.lapse_time; }
   bool avoiding() const { return avoiding_; }
   bool stopping() const { return stop_.has_value(); }
 

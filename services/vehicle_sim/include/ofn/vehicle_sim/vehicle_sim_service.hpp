@@ -23,8 +23,9 @@ struct VehicleSimConfig {
   double nav_rate = 100.0;       // Hz, NAV_STATE and SIM_CLOCK
   double command_timeout = 0.5;  // s without ACTUATOR_CMD before the service reports degraded
   /// Hold the vehicle in trimmed flight at its start state (the clock still
-  /// runs) until the controller reports it is flying the mission, as a
-  /// flight test begins when the autopilot is engaged.
+  /// runs) until the controller reports a mission (it then commands the
+  /// vehicle in every mode), as a flight test begins when the autopilot is
+  /// engaged.
   bool hold_until_engaged = true;
   /// Release the hold after this long anyway (s of clock time).
   double engage_timeout = 10.0;
