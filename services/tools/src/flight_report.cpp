@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
 
 #include "ofn/actuator_cmd_t.hpp"
 #include "ofn/bus_auth/trailer.hpp"
@@ -80,339 +81,388 @@ const char* kind_name(ObstacleSpec::Kind k) {
   return "box";
 }
 
-std::string json_number(std::optional<double> v) {
-  if (!v || !std::isfinite(*v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(10) << *v;
-  return s.str();
+/// A number for summary.json: null when absent or not finite.
+nlohmann::ordered_json json_number(std::optional<double> v) {
+  if (!v || !std::isfinite(*v)) return nullptr;
+  return *v;
 }
 
-}  // namespace
-
-ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
-                                 const std::optional<Scenario>& scenario,
-                                 const PseudoControlBound& pseudo_control_bound) {
-  lcm::LogFile log(log_path, "r");
-  if (!log.good()) throw std::invalid_argument("cannot read LCM log " + log_path);
-  namespace fs = std::filesystem;
-  const fs::path out(out_dir);
-  fs::create_directories(out);
-
-  ReportResult result;
+/// What a flight log holds, decoded, times in seconds from its first
+/// NAV_STATE: what the summary is judged from.
+struct FlightRecord {
   std::vector<NavSample> nav;
   std::vector<StatusSample> status;
   std::optional<mission_t> mission;
-  std::optional<Utime> t0;
-  auto rel = [&](Utime t) { return to_seconds(t - *t0); };
-
-  auto nav_csv =
-      open_csv(out / "nav_state.csv", "t,north,east,down,vn,ve,vd,an,ae,ad,roll,pitch,yaw,p,q,r");
-  auto status_csv = open_csv(out / "control_status.csv",
-                             "t,mode,mission_id,active_waypoint,ref_n,ref_e,ref_d,ref_vn,ref_ve,"
-                             "ref_vd,ref_an,ref_ae,ref_ad,cmd_an,cmd_ae,cmd_ad,err_n,err_e,err_d,"
-                             "yaw_ref");
-  auto cmd_csv = open_csv(out / "actuator_cmd.csv", "t,collective,lon_cyclic,lat_cyclic,pedal");
-  auto hb_csv = open_csv(out / "heartbeats.csv",
-                         "t,service,state,received,rejected,late,loop_time_mean,loop_time_max,"
-                         "cpu_fraction,unauthenticated");
-  // Every scan point of a long flight would make a plot unreadable and a
-  // file of hundreds of MB: keep every n-th point, up to a budget.
-  constexpr size_t kScanPointStride = 7;
-  constexpr size_t kMaxScanPoints = 300000;
-  auto scan_csv = open_csv(out / "scan_points.csv", "t,north,east,down");
-  size_t scan_points_seen = 0, scan_points_written = 0;
   std::optional<cuboid_list_t> last_cuboids;
-  // Planning: every global path, every n-th avoidance trajectory (a 10 Hz
-  // optimiser would otherwise paint a solid band), every solver report.
-  constexpr int kRefTrajStride = 5;
-  auto path_csv = open_csv(out / "global_path.csv", "t,seq,status,cost,north,east,down");
-  auto ref_csv = open_csv(out / "ref_traj.csv", "t,seq,mode,sample_t,north,east,down");
-  auto stats_csv = open_csv(out / "solver_stats.csv",
-                            "t,status,iterations,solve_time,max_violation,cost,warm_started");
-  int path_seq = 0, ref_seq = 0, ref_seen = 0;
+  double last_cuboids_t = 0;
+  size_t scan_points_seen = 0;
+  int paths = 0;
   std::vector<double> solve_times;
   std::map<int, int> solver_status_count;
   std::vector<TimeSpan> recovery;
   // Scan-to-plan latency: every map's stamp, and every step that planned.
   std::vector<double> map_stamps;
   std::vector<PlanStep> plan_steps;
-  auto row = [](std::ofstream& f, std::initializer_list<Vec3> vs) {
-    for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
-  };
 
-  // Events before the first navigation sample have no time base yet; keep
-  // them until it arrives.
+  int count(int solver_status) const {
+    const auto it = solver_status_count.find(solver_status);
+    return it == solver_status_count.end() ? 0 : it->second;
+  }
+};
+
+/// The per-channel CSV tables of a results folder, one writer each.
+class CsvTables {
+ public:
+  explicit CsvTables(const std::filesystem::path& out)
+      : nav_(open_csv(out / "nav_state.csv",
+                      "t,north,east,down,vn,ve,vd,an,ae,ad,roll,pitch,yaw,p,q,r")),
+        status_(open_csv(out / "control_status.csv",
+                         "t,mode,mission_id,active_waypoint,ref_n,ref_e,ref_d,ref_vn,ref_ve,"
+                         "ref_vd,ref_an,ref_ae,ref_ad,cmd_an,cmd_ae,cmd_ad,err_n,err_e,err_d,"
+                         "yaw_ref")),
+        command_(open_csv(out / "actuator_cmd.csv", "t,collective,lon_cyclic,lat_cyclic,pedal")),
+        heartbeat_(open_csv(out / "heartbeats.csv",
+                            "t,service,state,received,rejected,late,loop_time_mean,loop_time_max,"
+                            "cpu_fraction,unauthenticated")),
+        scan_(open_csv(out / "scan_points.csv", "t,north,east,down")),
+        path_(open_csv(out / "global_path.csv", "t,seq,status,cost,north,east,down")),
+        ref_(open_csv(out / "ref_traj.csv", "t,seq,mode,sample_t,north,east,down")),
+        stats_(open_csv(out / "solver_stats.csv",
+                        "t,status,iterations,solve_time,max_violation,cost,warm_started")) {}
+
+  void nav(const NavSample& s) {
+    nav_ << s.t;
+    row(nav_, {s.position, s.velocity, s.acceleration, s.euler, s.body_rates});
+    nav_ << "\n";
+  }
+  void status(const StatusSample& s) {
+    status_ << s.t << "," << s.mode << "," << s.mission_id << "," << s.active_waypoint;
+    row(status_,
+        {s.ref_position, s.ref_velocity, s.ref_acceleration, s.commanded_accel, s.position_error});
+    status_ << "," << s.yaw_reference << "\n";
+  }
+  void command(double t, const actuator_cmd_t& m) {
+    command_ << t << "," << m.collective << "," << m.lon_cyclic << "," << m.lat_cyclic << ","
+             << m.pedal << "\n";
+  }
+  // Every scan point of a long flight would make a plot unreadable and a
+  // file of hundreds of MB: every n-th point, up to a budget.
+  void scan(double t, const scan_world_t& m, size_t* seen) {
+    for (const auto& p : m.points) {
+      if ((*seen)++ % kScanPointStride != 0 || scan_points_written_ >= kMaxScanPoints) continue;
+      ++scan_points_written_;
+      scan_ << t << "," << p[0] << "," << p[1] << "," << p[2] << "\n";
+    }
+  }
+  void path(double t, int seq, const global_path_t& m) {
+    for (const auto& p : m.points)
+      path_ << t << "," << seq << "," << static_cast<int>(m.status) << "," << m.cost << "," << p[0]
+            << "," << p[1] << "," << p[2] << "\n";
+  }
+  // Every n-th avoidance trajectory: a 10 Hz optimiser would otherwise
+  // paint a solid band.
+  void ref_traj(double t, double t0, const ref_traj_t& m) {
+    if (m.mode == ref_traj_t::NOMINAL || ref_seen_++ % kRefTrajStride != 0) return;
+    for (size_t i = 0; i < m.sample_time.size(); ++i)
+      ref_ << t << "," << ref_seq_ << "," << static_cast<int>(m.mode) << ","
+           << t0 + m.sample_time[i] << "," << m.position[i][0] << "," << m.position[i][1] << ","
+           << m.position[i][2] << "\n";
+    ++ref_seq_;
+  }
+  void solver_stats(double t, const solver_stats_t& m) {
+    stats_ << t << "," << static_cast<int>(m.status) << "," << m.iterations << "," << m.solve_time
+           << "," << m.max_constraint_violation << "," << m.cost << "," << (m.warm_started ? 1 : 0)
+           << "\n";
+  }
+  void heartbeat(double t, const heartbeat_t& m) {
+    heartbeat_ << t << "," << csv_text(m.service) << "," << csv_text(m.state) << "," << m.received
+               << "," << m.rejected << "," << m.late << "," << m.loop_time_mean << ","
+               << m.loop_time_max << "," << m.cpu_fraction << "," << m.unauthenticated << "\n";
+  }
+
+  static void waypoints(const std::filesystem::path& out, const std::optional<mission_t>& mission) {
+    auto f = open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
+    if (!mission) return;
+    for (size_t i = 0; i < mission->waypoints.size(); ++i) {
+      const auto& w = mission->waypoints[i];
+      f << i << "," << w.position[0] << "," << w.position[1] << "," << w.position[2] << ","
+        << w.capture_radius << "\n";
+    }
+  }
+  /// The obstacle database as it stood at the end of the flight.
+  static void cuboids(const std::filesystem::path& out, const FlightRecord& record) {
+    auto f = open_csv(out / "cuboids.csv",
+                      "t,id,min_n,min_e,min_d,max_n,max_e,max_d,top_observed,confidence");
+    if (!record.last_cuboids) return;
+    for (const auto& c : record.last_cuboids->cuboids)
+      f << record.last_cuboids_t << "," << c.id << "," << c.min_corner[0] << "," << c.min_corner[1]
+        << "," << c.min_corner[2] << "," << c.max_corner[0] << "," << c.max_corner[1] << ","
+        << c.max_corner[2] << "," << (c.top_observed ? 1 : 0) << "," << c.confidence << "\n";
+  }
+
+ private:
+  static constexpr size_t kScanPointStride = 7;
+  static constexpr size_t kMaxScanPoints = 300000;
+  static constexpr int kRefTrajStride = 5;
+
+  static void row(std::ofstream& f, std::initializer_list<Vec3> vs) {
+    for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
+  }
+
+  std::ofstream nav_, status_, command_, heartbeat_, scan_, path_, ref_, stats_;
+  size_t scan_points_written_ = 0;
+  int ref_seen_ = 0, ref_seq_ = 0;
+};
+
+/// Decodes each logged message into the record and its table.
+class LogDecoder {
+ public:
+  LogDecoder(FlightRecord& record, CsvTables& tables, Utime t0)
+      : record_(record), tables_(tables), t0_(t0) {}
+
+  /// False when the message does not decode.
+  bool handle(const std::string& channel, const lcm::LogEvent& e) {
+    if (channel == channels::kNavState) return on<nav_state_t>(e, [this](auto& m) { nav(m); });
+    if (channel == channels::kControlStatus)
+      return on<control_status_t>(e, [this](auto& m) { control_status(m); });
+    if (channel == channels::kActuatorCmd)
+      return on<actuator_cmd_t>(e, [this](auto& m) { tables_.command(rel(m.utime), m); });
+    if (channel == channels::kScanWorld)
+      return on<scan_world_t>(
+          e, [this](auto& m) { tables_.scan(rel(m.utime), m, &record_.scan_points_seen); });
+    if (channel == channels::kCuboids)
+      return on<cuboid_list_t>(e, [this](auto& m) {
+        record_.last_cuboids_t = rel(m.utime);
+        record_.last_cuboids = std::move(m);
+      });
+    if (channel == channels::kGlobalPath)
+      return on<global_path_t>(e,
+                               [this](auto& m) { tables_.path(rel(m.utime), record_.paths++, m); });
+    if (channel == channels::kRefTraj)
+      return on<ref_traj_t>(e, [this](auto& m) {
+        // A plan sent as its spline alone is tabled as its receivers sample it.
+        if (validate(m).empty()) expand_ref_traj(m);
+        tables_.ref_traj(rel(m.utime), rel(m.t0_utime), m);
+      });
+    if (channel == channels::kSolverStats)
+      return on<solver_stats_t>(e, [this](auto& m) { solver_stats(m); });
+    if (channel == channels::kObstacleGrid)
+      return on<obstacle_grid_t>(e,
+                                 [this](auto& m) { record_.map_stamps.push_back(rel(m.utime)); });
+    if (channel == channels::kMission)
+      return on<mission_t>(e, [this](auto& m) { record_.mission = m; });
+    if (channel.rfind(channels::kHeartbeatPrefix, 0) == 0)
+      return on<heartbeat_t>(e, [this](auto& m) { tables_.heartbeat(rel(m.utime), m); });
+    return true;  // a channel the report does not read
+  }
+
+ private:
+  double rel(Utime t) const { return to_seconds(t - t0_); }
+
+  template <class Msg, class Use>
+  static bool on(const lcm::LogEvent& e, Use use) {
+    Msg m{};
+    if (!decode(e, m)) return false;
+    use(m);
+    return true;
+  }
+
+  void nav(const nav_state_t& m) {
+    NavSample s;
+    s.t = rel(m.utime);
+    s.position = to_vec3(m.position);
+    s.velocity = to_vec3(m.velocity);
+    s.acceleration = to_vec3(m.acceleration);
+    s.euler = to_vec3(m.euler);
+    s.body_rates = to_vec3(m.body_rates);
+    record_.nav.push_back(s);
+    tables_.nav(s);
+  }
+
+  void control_status(const control_status_t& m) {
+    StatusSample s;
+    s.t = rel(m.utime);
+    s.mode = m.mode;
+    s.mission_id = m.mission_id;
+    s.active_waypoint = m.active_waypoint;
+    s.ref_position = to_vec3(m.ref_position);
+    s.ref_velocity = to_vec3(m.ref_velocity);
+    s.ref_acceleration = to_vec3(m.ref_acceleration);
+    s.commanded_accel = to_vec3(m.commanded_acceleration);
+    s.position_error = to_vec3(m.position_error);
+    s.yaw_reference = m.yaw_reference;
+    record_.status.push_back(s);
+    tables_.status(s);
+  }
+
+  void solver_stats(const solver_stats_t& m) {
+    const double t = rel(m.utime);
+    tables_.solver_stats(t, m);
+    if (m.status != solver_stats_t::NOT_RUN) {
+      ++record_.solver_status_count[m.status];
+      record_.solve_times.push_back(m.solve_time);
+    }
+    // Steps that published a trajectory (a deferral leaves guidance on).
+    if (m.status != solver_stats_t::NOT_RUN && m.status != solver_stats_t::DEFERRED &&
+        m.map_utime > 0)
+      record_.plan_steps.push_back({t, rel(m.map_utime)});
+    // The dead-end recovery's steps, joined into spans (the optimiser
+    // reports at 5-20 Hz; a gap of a second ends a span).
+    const bool recovering = m.status == solver_stats_t::LOOKING_AROUND ||
+                            m.status == solver_stats_t::NO_ROUTE ||
+                            m.message.rfind("escaping", 0) == 0;
+    if (recovering) {
+      auto& spans = record_.recovery;
+      if (!spans.empty() && t - spans.back().end <= 1.0)
+        spans.back().end = t;
+      else
+        spans.push_back({t, t});
+    }
+  }
+
+  FlightRecord& record_;
+  CsvTables& tables_;
+  Utime t0_;
+};
+
+/// Reads the log into `record` and the tables. Events before the first
+/// navigation sample have no time base yet; they are kept until it comes.
+void read_log(const std::string& log_path, FlightRecord& record, CsvTables& tables,
+              ReportResult& result) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) throw std::invalid_argument("cannot read LCM log " + log_path);
+  std::optional<LogDecoder> decoder;
   std::vector<lcm::LogEvent> held;
   std::vector<std::vector<uint8_t>> held_data;
-  auto handle = [&](const std::string& channel, const lcm::LogEvent& e) {
-    if (channel == channels::kNavState) {
-      nav_state_t m{};
-      if (!decode(e, m)) return false;
-      NavSample s;
-      s.t = rel(m.utime);
-      s.position = to_vec3(m.position);
-      s.velocity = to_vec3(m.velocity);
-      s.acceleration = to_vec3(m.acceleration);
-      s.euler = to_vec3(m.euler);
-      s.body_rates = to_vec3(m.body_rates);
-      nav.push_back(s);
-      nav_csv << s.t;
-      row(nav_csv, {s.position, s.velocity, s.acceleration, s.euler, s.body_rates});
-      nav_csv << "\n";
-    } else if (channel == channels::kControlStatus) {
-      control_status_t m{};
-      if (!decode(e, m)) return false;
-      StatusSample s;
-      s.t = rel(m.utime);
-      s.mode = m.mode;
-      s.mission_id = m.mission_id;
-      s.active_waypoint = m.active_waypoint;
-      s.ref_position = to_vec3(m.ref_position);
-      s.ref_velocity = to_vec3(m.ref_velocity);
-      s.ref_acceleration = to_vec3(m.ref_acceleration);
-      s.commanded_accel = to_vec3(m.commanded_acceleration);
-      s.position_error = to_vec3(m.position_error);
-      s.yaw_reference = m.yaw_reference;
-      status.push_back(s);
-      status_csv << s.t << "," << s.mode << "," << s.mission_id << "," << s.active_waypoint;
-      row(status_csv, {s.ref_position, s.ref_velocity, s.ref_acceleration, s.commanded_accel,
-                       s.position_error});
-      status_csv << "," << s.yaw_reference << "\n";
-    } else if (channel == channels::kActuatorCmd) {
-      actuator_cmd_t m{};
-      if (!decode(e, m)) return false;
-      cmd_csv << rel(m.utime) << "," << m.collective << "," << m.lon_cyclic << "," << m.lat_cyclic
-              << "," << m.pedal << "\n";
-    } else if (channel == channels::kScanWorld) {
-      scan_world_t m{};
-      if (!decode(e, m)) return false;
-      for (const auto& p : m.points) {
-        if (scan_points_seen++ % kScanPointStride != 0 || scan_points_written >= kMaxScanPoints)
-          continue;
-        ++scan_points_written;
-        scan_csv << rel(m.utime) << "," << p[0] << "," << p[1] << "," << p[2] << "\n";
-      }
-    } else if (channel == channels::kCuboids) {
-      cuboid_list_t m{};
-      if (!decode(e, m)) return false;
-      last_cuboids = std::move(m);
-    } else if (channel == channels::kGlobalPath) {
-      global_path_t m{};
-      if (!decode(e, m)) return false;
-      for (const auto& p : m.points)
-        path_csv << rel(m.utime) << "," << path_seq << "," << static_cast<int>(m.status) << ","
-                 << m.cost << "," << p[0] << "," << p[1] << "," << p[2] << "\n";
-      ++path_seq;
-    } else if (channel == channels::kRefTraj) {
-      ref_traj_t m{};
-      if (!decode(e, m)) return false;
-      // A plan sent as its spline alone is tabled as its receivers sample it.
-      if (validate(m).empty()) expand_ref_traj(m);
-      if (m.mode != ref_traj_t::NOMINAL && ref_seen++ % kRefTrajStride == 0) {
-        for (size_t i = 0; i < m.sample_time.size(); ++i)
-          ref_csv << rel(m.utime) << "," << ref_seq << "," << static_cast<int>(m.mode) << ","
-                  << rel(m.t0_utime) + m.sample_time[i] << "," << m.position[i][0] << ","
-                  << m.position[i][1] << "," << m.position[i][2] << "\n";
-        ++ref_seq;
-      }
-    } else if (channel == channels::kSolverStats) {
-      solver_stats_t m{};
-      if (!decode(e, m)) return false;
-      stats_csv << rel(m.utime) << "," << static_cast<int>(m.status) << "," << m.iterations << ","
-                << m.solve_time << "," << m.max_constraint_violation << "," << m.cost << ","
-                << (m.warm_started ? 1 : 0) << "\n";
-      if (m.status != solver_stats_t::NOT_RUN) {
-        ++solver_status_count[m.status];
-        solve_times.push_back(m.solve_time);
-      }
-      // Steps that published a trajectory (a deferral leaves guidance on).
-      if (m.status != solver_stats_t::NOT_RUN && m.status != solver_stats_t::DEFERRED &&
-          m.map_utime > 0)
-        plan_steps.push_back({rel(m.utime), rel(m.map_utime)});
-      // The dead-end recovery's steps, joined into spans (the optimiser
-      // reports at 5-20 Hz; a gap of a second ends a span).
-      const bool recovering = m.status == solver_stats_t::LOOKING_AROUND ||
-                              m.status == solver_stats_t::NO_ROUTE ||
-                              m.message.rfind("escaping", 0) == 0;
-      if (recovering) {
-        const double t = rel(m.utime);
-        if (!recovery.empty() && t - recovery.back().end <= 1.0)
-          recovery.back().end = t;
-        else
-          recovery.push_back({t, t});
-      }
-    } else if (channel == channels::kObstacleGrid) {
-      obstacle_grid_t m{};
-      if (!decode(e, m)) return false;
-      map_stamps.push_back(rel(m.utime));
-    } else if (channel == channels::kMission) {
-      mission_t m{};
-      if (!decode(e, m)) return false;
-      mission = m;
-    } else if (channel.rfind(channels::kHeartbeatPrefix, 0) == 0) {
-      heartbeat_t m{};
-      if (!decode(e, m)) return false;
-      hb_csv << rel(m.utime) << "," << csv_text(m.service) << "," << csv_text(m.state) << ","
-             << m.received << "," << m.rejected << "," << m.late << "," << m.loop_time_mean << ","
-             << m.loop_time_max << "," << m.cpu_fraction << "," << m.unauthenticated << "\n";
-    }
-    return true;
-  };
-
   while (const lcm::LogEvent* e = log.readNextEvent()) {
     ++result.events;
-    if (!t0) {
+    if (!decoder) {
       if (e->channel == channels::kNavState) {
         nav_state_t m{};
-        if (decode(*e, m)) t0 = m.utime;
+        if (decode(*e, m)) decoder.emplace(record, tables, m.utime);
       }
-      if (!t0) {
+      if (!decoder) {
         held.push_back(*e);
         held_data.emplace_back(static_cast<const uint8_t*>(e->data),
                                static_cast<const uint8_t*>(e->data) + e->datalen);
-        held.back().data = held_data.back().data();
         continue;
       }
       for (size_t i = 0; i < held.size(); ++i) {
         held[i].data = held_data[i].data();
-        if (!handle(held[i].channel, held[i])) ++result.undecodable;
+        if (!decoder->handle(held[i].channel, held[i])) ++result.undecodable;
       }
       held.clear();
     }
-    if (!handle(e->channel, *e)) ++result.undecodable;
+    if (!decoder->handle(e->channel, *e)) ++result.undecodable;
   }
   // Bad input (exit code 2), like an unreadable log.
-  if (nav.empty()) throw std::invalid_argument(log_path + ": no NAV_STATE messages in the log");
+  if (record.nav.empty())
+    throw std::invalid_argument(log_path + ": no NAV_STATE messages in the log");
   // A multi-process log holds messages in arrival order.
-  std::sort(map_stamps.begin(), map_stamps.end());
-  std::sort(plan_steps.begin(), plan_steps.end(),
+  std::sort(record.map_stamps.begin(), record.map_stamps.end());
+  std::sort(record.plan_steps.begin(), record.plan_steps.end(),
             [](const PlanStep& a, const PlanStep& b) { return a.published < b.published; });
-  const std::vector<double> scan_to_plan = scan_to_plan_latencies(map_stamps, plan_steps);
+}
 
+/// What the summaries report beside the record: the course's facts and
+/// what was judged from them.
+struct Judged {
+  std::string name;
+  std::string log_path;
   Limits limits;
-  if (mission) {
-    limits = limits_from(mission->limits);
-    auto wp_csv = open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
-    for (size_t i = 0; i < mission->waypoints.size(); ++i) {
-      const auto& w = mission->waypoints[i];
-      wp_csv << i << "," << w.position[0] << "," << w.position[1] << "," << w.position[2] << ","
-             << w.capture_radius << "\n";
-    }
-  } else {
-    open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
-  }
-  {
-    // The obstacle database as it stood at the end of the flight.
-    auto cuboid_csv = open_csv(out / "cuboids.csv",
-                               "t,id,min_n,min_e,min_d,max_n,max_e,max_d,top_observed,confidence");
-    if (last_cuboids)
-      for (const auto& c : last_cuboids->cuboids)
-        cuboid_csv << rel(last_cuboids->utime) << "," << c.id << "," << c.min_corner[0] << ","
-                   << c.min_corner[1] << "," << c.min_corner[2] << "," << c.max_corner[0] << ","
-                   << c.max_corner[1] << "," << c.max_corner[2] << "," << (c.top_observed ? 1 : 0)
-                   << "," << c.confidence << "\n";
-  }
-  // True clearance: distance from the flown path to the real surfaces, the
-  // obstacles present at that time and the ground, over the whole flight.
+  std::optional<double> start_gate, finish_gate;
+  PseudoControlBound pseudo_control_bound;
   std::optional<Clearance> clearance;
-  if (scenario)
-    clearance = least_clearance(nav, world::World(scenario->obstacles, scenario->ground_altitude));
-  const std::optional<double> min_clearance =
-      clearance ? std::optional<double>(clearance->distance) : std::nullopt;
-  result.min_clearance = min_clearance;
-  const auto start_gate = scenario ? scenario->start_gate : std::nullopt;
-  const auto finish_gate = scenario ? scenario->finish_gate : std::nullopt;
-  result.summary = analyse_flight(nav, status, limits, start_gate, finish_gate, recovery);
+  std::vector<double> scan_to_plan;
+  DisplayUnit unit;
+};
+
+nlohmann::ordered_json summary_json(const FlightRecord& record, const Judged& j,
+                                    const ReportResult& result,
+                                    const std::optional<Scenario>& scenario) {
+  using Json = nlohmann::ordered_json;
   const FlightSummary& s = result.summary;
+  const auto& c = j.clearance;
+  Json json;
+  json["scenario"] = j.name;
+  json["log"] = j.log_path;
+  json["display_unit"] = j.unit.name;
+  json["metres_per_unit"] = j.unit.metres_per_unit;
+  json["limits"] = {{"max_speed", j.limits.max_speed},
+                    {"max_accel", j.limits.max_accel},
+                    {"max_vertical_speed", j.limits.max_vertical_speed}};
+  json["gates"] = {{"start_x", json_number(j.start_gate)},
+                   {"finish_x", json_number(j.finish_gate)}};
+  json["gate_start_t"] = json_number(s.gate_start_time);
+  json["gate_finish_t"] = json_number(s.gate_finish_time);
+  json["gate_to_gate"] = json_number(s.gate_to_gate);
+  json["reached_last_waypoint"] = s.reached_last_waypoint;
+  json["crossed_finish"] = s.crossed_finish;
+  json["duration"] = s.duration;
+  json["max_speed"] = s.max_speed;
+  json["max_vertical_speed"] = s.max_vertical_speed;
+  json["min_forward_speed"] = s.min_forward_speed;
+  json["max_commanded_accel"] = s.max_commanded_accel;
+  json["max_commanded_accel_fraction"] = s.max_commanded_accel_fraction;
+  json["max_pseudo_control"] = s.max_pseudo_control;
+  json["max_pseudo_control_horizontal"] = s.max_pseudo_control_horizontal;
+  json["max_pseudo_control_vertical"] = s.max_pseudo_control_vertical;
+  json["pseudo_control_bound"] = {{"horizontal", j.pseudo_control_bound.horizontal},
+                                  {"vertical", j.pseudo_control_bound.vertical}};
+  json["max_ref_position_jump"] = s.max_ref_position_jump;
+  json["max_ref_position_jump_t"] = json_number(s.max_ref_position_jump_t);
+  json["max_ref_velocity_jump"] = s.max_ref_velocity_jump;
+  json["final_max_speed"] = json_number(s.final_max_speed);
+  json["tracking_rms"] = s.tracking_rms;
+  json["tracking_max"] = s.tracking_max;
+  json["min_clearance"] = json_number(c ? std::optional<double>(c->distance) : std::nullopt);
+  json["min_clearance_t"] = json_number(c ? std::optional<double>(c->t) : std::nullopt);
+  json["min_clearance_surface"] = c ? Json(c->to_ground ? "ground" : "obstacle") : Json(nullptr);
+  json["clearance_required"] = j.limits.clearance;
+  json["rh_steps"] = record.solve_times.size();
+  json["rh_solve_time_median"] = json_number(percentile(record.solve_times, 0.5));
+  json["rh_solve_time_p99"] = json_number(percentile(record.solve_times, 0.99));
+  json["rh_solve_time_max"] = json_number(percentile(record.solve_times, 1.0));
+  json["rh_kept_previous"] = record.count(solver_stats_t::KEPT_PREVIOUS);
+  json["rh_braking"] = record.count(solver_stats_t::BRAKING);
+  json["rh_deferred"] = record.count(solver_stats_t::DEFERRED);
+  json["rh_looking_around"] = record.count(solver_stats_t::LOOKING_AROUND);
+  json["rh_no_route"] = record.count(solver_stats_t::NO_ROUTE);
+  json["scan_to_plan_scans"] = j.scan_to_plan.size();
+  json["scan_to_plan_median"] = json_number(percentile(j.scan_to_plan, 0.5));
+  json["scan_to_plan_p99"] = json_number(percentile(j.scan_to_plan, 0.99));
+  json["scan_to_plan_max"] = json_number(percentile(j.scan_to_plan, 1.0));
+  json["recovery_time"] = s.recovery_time;
+  json["outcome"] = to_string(result.verdict.outcome);
+  json["success"] = result.verdict.success;
+  json["failures"] = result.verdict.failures;
+  // Metres, like every other length in this file (the plot scales them).
+  json["obstacles"] = Json::array();
+  if (scenario)
+    for (const auto& o : scenario->obstacles)
+      json["obstacles"].push_back({{"id", o.id},
+                                   {"kind", kind_name(o.kind)},
+                                   {"center", {o.north, o.east}},
+                                   {"size", {o.length, o.width}},
+                                   {"height", o.height},
+                                   {"yaw", o.yaw},
+                                   {"appear_time", o.appear_time},
+                                   {"disappear_time", o.disappear_time}});
+  return json;
+}
 
-  const std::string unit = scenario ? scenario->display_unit : "m";
-  const double k = scenario ? scenario->metres_per_unit : 1.0;
-  result.verdict = judge_flight(s, limits, pseudo_control_bound, min_clearance,
-                                finish_gate.has_value(), DisplayUnit{unit, k});
-  const std::string name = scenario ? scenario->name : (mission ? mission->name : "flight");
-
-  std::ofstream json(out / "summary.json");
-  json << std::setprecision(10) << "{\n"
-       << "  \"scenario\": \"" << name << "\",\n"
-       << "  \"log\": \"" << log_path << "\",\n"
-       << "  \"display_unit\": \"" << unit << "\",\n"
-       << "  \"metres_per_unit\": " << k << ",\n"
-       << "  \"limits\": {\"max_speed\": " << limits.max_speed
-       << ", \"max_accel\": " << limits.max_accel
-       << ", \"max_vertical_speed\": " << limits.max_vertical_speed << "},\n"
-       << "  \"gates\": {\"start_x\": " << json_number(start_gate)
-       << ", \"finish_x\": " << json_number(finish_gate) << "},\n"
-       << "  \"gate_start_t\": " << json_number(s.gate_start_time) << ",\n"
-       << "  \"gate_finish_t\": " << json_number(s.gate_finish_time) << ",\n"
-       << "  \"gate_to_gate\": " << json_number(s.gate_to_gate) << ",\n"
-       << "  \"reached_last_waypoint\": " << (s.reached_last_waypoint ? "true" : "false") << ",\n"
-       << "  \"crossed_finish\": " << (s.crossed_finish ? "true" : "false") << ",\n"
-       << "  \"duration\": " << s.duration << ",\n"
-       << "  \"max_speed\": " << s.max_speed << ",\n"
-       << "  \"max_vertical_speed\": " << s.max_vertical_speed << ",\n"
-       << "  \"min_forward_speed\": " << s.min_forward_speed << ",\n"
-       << "  \"max_commanded_accel\": " << s.max_commanded_accel << ",\n"
-       << "  \"max_commanded_accel_fraction\": " << s.max_commanded_accel_fraction << ",\n"
-       << "  \"max_pseudo_control\": " << s.max_pseudo_control << ",\n"
-       << "  \"max_pseudo_control_horizontal\": " << s.max_pseudo_control_horizontal << ",\n"
-       << "  \"max_pseudo_control_vertical\": " << s.max_pseudo_control_vertical << ",\n"
-       << "  \"pseudo_control_bound\": {\"horizontal\": " << pseudo_control_bound.horizontal
-       << ", \"vertical\": " << pseudo_control_bound.vertical << "},\n"
-       << "  \"max_ref_position_jump\": " << s.max_ref_position_jump << ",\n"
-       << "  \"max_ref_position_jump_t\": " << json_number(s.max_ref_position_jump_t) << ",\n"
-       << "  \"max_ref_velocity_jump\": " << s.max_ref_velocity_jump << ",\n"
-       << "  \"final_max_speed\": " << json_number(s.final_max_speed) << ",\n"
-       << "  \"tracking_rms\": " << s.tracking_rms << ",\n"
-       << "  \"tracking_max\": " << s.tracking_max << ",\n"
-       << "  \"min_clearance\": " << json_number(min_clearance) << ",\n"
-       << "  \"min_clearance_t\": " << (clearance ? json_number(clearance->t) : "null") << ",\n"
-       << "  \"min_clearance_surface\": "
-       << (clearance ? (clearance->to_ground ? "\"ground\"" : "\"obstacle\"") : "null") << ",\n"
-       << "  \"clearance_required\": " << limits.clearance << ",\n"
-       << "  \"rh_steps\": " << solve_times.size() << ",\n"
-       << "  \"rh_solve_time_median\": " << json_number(percentile(solve_times, 0.5)) << ",\n"
-       << "  \"rh_solve_time_p99\": " << json_number(percentile(solve_times, 0.99)) << ",\n"
-       << "  \"rh_solve_time_max\": " << json_number(percentile(solve_times, 1.0)) << ",\n"
-       << "  \"rh_kept_previous\": " << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ",\n"
-       << "  \"rh_braking\": " << solver_status_count[solver_stats_t::BRAKING] << ",\n"
-       << "  \"rh_deferred\": " << solver_status_count[solver_stats_t::DEFERRED] << ",\n"
-       << "  \"rh_looking_around\": " << solver_status_count[solver_stats_t::LOOKING_AROUND]
-       << ",\n"
-       << "  \"rh_no_route\": " << solver_status_count[solver_stats_t::NO_ROUTE] << ",\n"
-       << "  \"scan_to_plan_scans\": " << scan_to_plan.size() << ",\n"
-       << "  \"scan_to_plan_median\": " << json_number(percentile(scan_to_plan, 0.5)) << ",\n"
-       << "  \"scan_to_plan_p99\": " << json_number(percentile(scan_to_plan, 0.99)) << ",\n"
-       << "  \"scan_to_plan_max\": " << json_number(percentile(scan_to_plan, 1.0)) << ",\n"
-       << "  \"recovery_time\": " << s.recovery_time << ",\n"
-       << "  \"outcome\": \"" << to_string(result.verdict.outcome) << "\",\n"
-       << "  \"success\": " << (result.verdict.success ? "true" : "false") << ",\n"
-       << "  \"failures\": [";
-  for (size_t i = 0; i < result.verdict.failures.size(); ++i)
-    json << (i ? ", " : "") << "\"" << result.verdict.failures[i] << "\"";
-  json << "],\n"
-       << "  \"obstacles\": [";
-  if (scenario) {
-    // Metres, like every other length in this file (the plot scales them).
-    const auto& obs = scenario->obstacles;
-    for (size_t i = 0; i < obs.size(); ++i) {
-      const auto& o = obs[i];
-      json << (i ? ",\n    " : "\n    ") << "{\"id\": " << o.id << ", \"kind\": \""
-           << kind_name(o.kind) << "\", \"center\": [" << o.north << ", " << o.east
-           << "], \"size\": [" << o.length << ", " << o.width << "], \"height\": " << o.height
-           << ", \"yaw\": " << o.yaw << ", \"appear_time\": " << o.appear_time
-           << ", \"disappear_time\": " << o.disappear_time << "}";
-    }
-    if (!obs.empty()) json << "\n  ";
-  }
-  json << "]\n}\n";
-
+std::string summary_text(const FlightRecord& record, const Judged& j, const ReportResult& result,
+                         const std::filesystem::path& out) {
+  const FlightSummary& s = result.summary;
+  const std::string& unit = j.unit.name;
+  const double k = j.unit.metres_per_unit;
   std::ostringstream t;
   t << std::fixed << std::setprecision(2);
-  t << "Flight '" << name << "' (" << result.events << " logged messages, " << s.duration
+  t << "Flight '" << j.name << "' (" << result.events << " logged messages, " << s.duration
     << " s of navigation data)\n";
   t << "  result            : "
     << (s.reached_last_waypoint ? "reached the last waypoint" : "did NOT reach the last waypoint");
-  if (finish_gate)
+  if (j.finish_gate)
     t << (s.crossed_finish ? ", crossed the finish gate" : ", did NOT cross the finish gate");
   t << "\n";
   t << "  outcome           : " << to_string(result.verdict.outcome);
@@ -431,62 +481,108 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   }
   t << "\n";
   if (s.gate_to_gate)
-    t << "  gate-to-gate time : " << *s.gate_to_gate << " s (x = " << *start_gate / k << " -> "
-      << *finish_gate / k << " " << unit << ")\n";
-  else if (start_gate || finish_gate)
+    t << "  gate-to-gate time : " << *s.gate_to_gate << " s (x = " << *j.start_gate / k << " -> "
+      << *j.finish_gate / k << " " << unit << ")\n";
+  else if (j.start_gate || j.finish_gate)
     t << "  gate-to-gate time : n/a (a gate was not crossed)\n";
   t << "  max speed         : " << s.max_speed / k << " " << unit << "/s (limit "
-    << limits.max_speed / k << ")\n";
+    << j.limits.max_speed / k << ")\n";
   t << "  max reference acc : " << s.max_commanded_accel / k << " " << unit
     << "/s^2 = " << std::setprecision(0) << 100.0 * s.max_commanded_accel_fraction
-    << std::setprecision(2) << " % of the " << limits.max_accel / k << " " << unit
+    << std::setprecision(2) << " % of the " << j.limits.max_accel / k << " " << unit
     << "/s^2 limit (planned)\n";
   t << "  max pseudo-control: " << s.max_pseudo_control / k << " " << unit
     << "/s^2 (command plus feedback corrections); horizontal "
     << s.max_pseudo_control_horizontal / k << ", vertical " << s.max_pseudo_control_vertical / k
-    << " (bounds " << pseudo_control_bound.horizontal / k << ", "
-    << pseudo_control_bound.vertical / k << ")\n";
+    << " (bounds " << j.pseudo_control_bound.horizontal / k << ", "
+    << j.pseudo_control_bound.vertical / k << ")\n";
   t << "  reference jump    : " << s.max_ref_position_jump / k << " " << unit << ", "
     << s.max_ref_velocity_jump / k << " " << unit << "/s between samples (largest; position bound "
     << kMaxReferenceJump / k << " " << unit << ")\n";
   t << "  tracking error    : RMS " << s.tracking_rms / k << " " << unit << ", max "
     << s.tracking_max / k << " " << unit << "\n";
-  if (clearance)
-    t << "  least clearance   : " << clearance->distance / k << " " << unit
-      << (clearance->to_ground ? " to the ground" : " to a real obstacle")
-      << " at t = " << clearance->t << " s (required " << limits.clearance / k << ")\n";
-  if (last_cuboids)
-    t << "  obstacle database : " << last_cuboids->num_cuboids << " cuboids at the end, "
-      << scan_points_seen << " LIDAR points mapped\n";
-  if (!solve_times.empty()) {
-    t << "  RH optimiser      : " << solve_times.size() << " steps, solve time median "
-      << std::setprecision(1) << 1e3 * *percentile(solve_times, 0.5) << " ms, p99 "
-      << 1e3 * *percentile(solve_times, 0.99) << " ms, max " << 1e3 * *percentile(solve_times, 1.0)
+  if (j.clearance)
+    t << "  least clearance   : " << j.clearance->distance / k << " " << unit
+      << (j.clearance->to_ground ? " to the ground" : " to a real obstacle")
+      << " at t = " << j.clearance->t << " s (required " << j.limits.clearance / k << ")\n";
+  if (record.last_cuboids)
+    t << "  obstacle database : " << record.last_cuboids->num_cuboids << " cuboids at the end, "
+      << record.scan_points_seen << " LIDAR points mapped\n";
+  const auto& solves = record.solve_times;
+  if (!solves.empty()) {
+    t << "  RH optimiser      : " << solves.size() << " steps, solve time median "
+      << std::setprecision(1) << 1e3 * *percentile(solves, 0.5) << " ms, p99 "
+      << 1e3 * *percentile(solves, 0.99) << " ms, max " << 1e3 * *percentile(solves, 1.0)
       << std::setprecision(2) << " ms; kept previous "
-      << solver_status_count[solver_stats_t::KEPT_PREVIOUS] << ", braking "
-      << solver_status_count[solver_stats_t::BRAKING] << ", deferred "
-      << solver_status_count[solver_stats_t::DEFERRED] << ", looking around "
-      << solver_status_count[solver_stats_t::LOOKING_AROUND] << ", no route "
-      << solver_status_count[solver_stats_t::NO_ROUTE] << "; " << std::setprecision(1)
-      << s.recovery_time << " s in dead-end recovery\n"
+      << record.count(solver_stats_t::KEPT_PREVIOUS) << ", braking "
+      << record.count(solver_stats_t::BRAKING) << ", deferred "
+      << record.count(solver_stats_t::DEFERRED) << ", looking around "
+      << record.count(solver_stats_t::LOOKING_AROUND) << ", no route "
+      << record.count(solver_stats_t::NO_ROUTE) << "; " << std::setprecision(1) << s.recovery_time
+      << " s in dead-end recovery\n"
       << std::setprecision(2);
   } else {
     t << "  RH optimiser      : never engaged (nominal waypoint guidance throughout)\n";
   }
-  if (!scan_to_plan.empty())
-    t << "  scan to plan      : median " << std::setprecision(0)
-      << 1e3 * *percentile(scan_to_plan, 0.5) << " ms, p99 "
-      << 1e3 * *percentile(scan_to_plan, 0.99) << " ms, max "
-      << 1e3 * *percentile(scan_to_plan, 1.0) << " ms over " << scan_to_plan.size()
+  const auto& latency = j.scan_to_plan;
+  if (!latency.empty())
+    t << "  scan to plan      : median " << std::setprecision(0) << 1e3 * *percentile(latency, 0.5)
+      << " ms, p99 " << 1e3 * *percentile(latency, 0.99) << " ms, max "
+      << 1e3 * *percentile(latency, 1.0) << " ms over " << latency.size()
       << " scans while avoiding (a scan's stamp to the first RH step on a map holding it)\n"
       << std::setprecision(2);
-  if (path_seq > 0) t << "  global planner    : " << path_seq << " paths published\n";
+  if (record.paths > 0) t << "  global planner    : " << record.paths << " paths published\n";
   if (result.undecodable)
     t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
   t << "  files             : " << out.string() << "/{nav_state,control_status,actuator_cmd,"
     << "heartbeats,waypoints,scan_points,cuboids,global_path,ref_traj,solver_stats}.csv, "
     << "summary.json\n";
-  result.text = t.str();
+  return t.str();
+}
+
+}  // namespace
+
+ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
+                                 const std::optional<Scenario>& scenario,
+                                 const PseudoControlBound& pseudo_control_bound) {
+  namespace fs = std::filesystem;
+  if (!lcm::LogFile(log_path, "r").good())
+    throw std::invalid_argument("cannot read LCM log " + log_path);
+  const fs::path out(out_dir);
+  fs::create_directories(out);
+
+  ReportResult result;
+  FlightRecord record;
+  {
+    CsvTables tables(out);
+    read_log(log_path, record, tables, result);
+  }
+  CsvTables::waypoints(out, record.mission);
+  CsvTables::cuboids(out, record);
+
+  Judged j;
+  j.log_path = log_path;
+  j.name = scenario ? scenario->name : (record.mission ? record.mission->name : "flight");
+  if (record.mission) j.limits = limits_from(record.mission->limits);
+  j.start_gate = scenario ? scenario->start_gate : std::nullopt;
+  j.finish_gate = scenario ? scenario->finish_gate : std::nullopt;
+  j.pseudo_control_bound = pseudo_control_bound;
+  j.scan_to_plan = scan_to_plan_latencies(record.map_stamps, record.plan_steps);
+  j.unit = DisplayUnit{scenario ? scenario->display_unit : "m",
+                       scenario ? scenario->metres_per_unit : 1.0};
+  // True clearance: distance from the flown path to the real surfaces, the
+  // obstacles present at that time and the ground, over the whole flight.
+  if (scenario)
+    j.clearance =
+        least_clearance(record.nav, world::World(scenario->obstacles, scenario->ground_altitude));
+  result.min_clearance = j.clearance ? std::optional<double>(j.clearance->distance) : std::nullopt;
+  result.summary = analyse_flight(record.nav, record.status, j.limits, j.start_gate, j.finish_gate,
+                                  record.recovery);
+  result.verdict = judge_flight(result.summary, j.limits, pseudo_control_bound,
+                                result.min_clearance, j.finish_gate.has_value(), j.unit);
+
+  std::ofstream(out / "summary.json") << summary_json(record, j, result, scenario).dump(2) << "\n";
+  result.text = summary_text(record, j, result, out);
   std::ofstream(out / "summary.txt") << result.text;
   return result;
 }

@@ -1,0 +1,167 @@
+// The flight report on logs written here: a short hover on the open course,
+// what its summary.json and tables hold, and input that must not break them.
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+
+#include "ofn/common/channels.hpp"
+#include "ofn/common/clock.hpp"
+#include "ofn/common/scenario.hpp"
+#include "ofn/control_status_t.hpp"
+#include "ofn/heartbeat_t.hpp"
+#include "ofn/nav_state_t.hpp"
+#include "ofn/tools/flight_report.hpp"
+
+namespace ofn::report {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kOpenScenario = std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml";
+
+class FlightReport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("ofn-flight-report-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  template <class Msg>
+  static void write(lcm::LogFile& log, const std::string& channel, const Msg& m, Utime t) {
+    std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    lcm::LogEvent e{};
+    e.timestamp = t;
+    e.channel = channel;
+    e.datalen = static_cast<int32_t>(bytes.size());
+    e.data = bytes.data();
+    log.writeEvent(&e);
+  }
+
+  /// A hover of `seconds` at `here`: NAV_STATE at 100 Hz, CONTROL_STATUS at
+  /// 50 Hz (mode HOLD), and a heartbeat from a service with a hostile name.
+  std::string hover_log(const std::string& name, const Vec3& here, double seconds) {
+    const std::string path = (dir_ / name).string();
+    lcm::LogFile log(path, "w");
+    EXPECT_TRUE(log.good());
+    const Utime t0 = 1000 * kMicrosPerSecond;
+    for (int i = 0; i <= static_cast<int>(seconds * 100); ++i) {
+      const Utime t = t0 + i * 10000;
+      nav_state_t nav{};
+      nav.utime = t;
+      nav.frame = "NED";
+      for (int k = 0; k < 3; ++k) nav.position[k] = here[k];
+      nav.quaternion[0] = 1.0;
+      write(log, channels::kNavState, nav, t);
+      if (i % 2 == 0) {
+        control_status_t s{};
+        s.utime = t;
+        s.mode = control_status_t::HOLD;
+        s.mission_id = -1;
+        s.active_waypoint = -1;
+        for (int k = 0; k < 3; ++k) s.ref_position[k] = here[k];
+        write(log, channels::kControlStatus, s, t);
+      }
+    }
+    heartbeat_t hb{};
+    hb.utime = t0;
+    hb.service = "a \"quoted\", service\nname";
+    hb.state = "running";
+    write(log, std::string(channels::kHeartbeatPrefix) + "MAPPER", hb, t0);
+    return path;
+  }
+
+  static nlohmann::json read_json(const fs::path& path) {
+    std::ifstream f(path);
+    return nlohmann::json::parse(f);
+  }
+
+  static size_t lines_of(const fs::path& path) {
+    std::ifstream f(path);
+    size_t n = 0;
+    for (std::string line; std::getline(f, line);) ++n;
+    return n;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(FlightReport, AHoverIsTabledAndSummarised) {
+  const Scenario open = load_scenario(kOpenScenario);
+  const Vec3 start = open.start_position;
+  const std::string log = hover_log("hover.lcm", start, 3.0);
+  const fs::path out = dir_ / "report";
+  const ReportResult result = write_flight_report(log, out.string(), open, PseudoControlBound{});
+
+  EXPECT_EQ(result.undecodable, 0u);
+  EXPECT_EQ(result.events, 301u + 151u + 1u);
+  EXPECT_NEAR(result.summary.duration, 3.0, 1e-9);
+  EXPECT_FALSE(result.summary.reached_last_waypoint);
+  // One header line, then one row per message.
+  EXPECT_EQ(lines_of(out / "nav_state.csv"), 1u + 301u);
+  EXPECT_EQ(lines_of(out / "control_status.csv"), 1u + 151u);
+  // The heartbeat's name quoted as CSV: its line break inside the quotes.
+  EXPECT_EQ(lines_of(out / "heartbeats.csv"), 1u + 2u);
+  std::ifstream heartbeats(out / "heartbeats.csv");
+  const std::string table((std::istreambuf_iterator<char>(heartbeats)),
+                          std::istreambuf_iterator<char>());
+  EXPECT_NE(table.find(",\"a \"\"quoted\"\", service\nname\",running,"), std::string::npos)
+      << table;
+
+  const nlohmann::json json = read_json(out / "summary.json");
+  EXPECT_EQ(json.at("scenario"), open.name);
+  EXPECT_EQ(json.at("log"), log);
+  EXPECT_EQ(json.at("outcome"), to_string(result.verdict.outcome));
+  EXPECT_EQ(json.at("success"), result.verdict.success);
+  EXPECT_DOUBLE_EQ(json.at("duration").get<double>(), result.summary.duration);
+  EXPECT_EQ(json.at("rh_steps"), 0);
+  // Nothing measured is null, not a number that is not one.
+  EXPECT_TRUE(json.at("gate_to_gate").is_null());
+  EXPECT_TRUE(json.at("rh_solve_time_median").is_null());
+  ASSERT_TRUE(json.at("min_clearance").is_number());
+  EXPECT_NEAR(json.at("min_clearance").get<double>(), *result.min_clearance, 1e-12);
+  EXPECT_EQ(json.at("failures").size(), result.verdict.failures.size());
+  EXPECT_EQ(json.at("obstacles").size(), open.obstacles.size());
+}
+
+// A scenario named with quotes, backslashes and a line break, a log path
+// with a quote, failure lines quoting them: summary.json stays JSON and
+// says them as they are.
+TEST_F(FlightReport, NamesWithQuotesStayJson) {
+  Scenario open = load_scenario(kOpenScenario);
+  open.name = "the \"hard\" course \\ 2\nsecond line";
+  const std::string log = hover_log("it's \"a\" log.lcm", open.start_position, 1.0);
+  const fs::path out = dir_ / "report";
+  write_flight_report(log, out.string(), open, PseudoControlBound{});
+  const nlohmann::json json = read_json(out / "summary.json");
+  EXPECT_EQ(json.at("scenario"), open.name);
+  EXPECT_EQ(json.at("log"), log);
+}
+
+TEST_F(FlightReport, ALogWithoutNavigationIsBadInput) {
+  const std::string path = (dir_ / "empty.lcm").string();
+  {
+    lcm::LogFile log(path, "w");
+    ASSERT_TRUE(log.good());
+  }
+  EXPECT_THROW(write_flight_report(path, (dir_ / "out").string(), std::nullopt, {}),
+               std::invalid_argument);
+  EXPECT_THROW(write_flight_report((dir_ / "missing.lcm").string(), (dir_ / "out").string(),
+                                   std::nullopt, {}),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ofn::report
