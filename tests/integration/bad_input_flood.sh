@@ -44,7 +44,8 @@ grep -q "monitor: DONE not taken" "$WORK/launch.txt" || fail "the forged DONE we
 import csv, json, math, sys
 limit = json.load(open(sys.argv[1] + "/summary.json"))["limits"]["max_speed"]
 fastest = 0.0
-for row in csv.DictReader(open(sys.argv[1] + "/control_status.csv")):
+for r in csv.DictReader(open(sys.argv[1] + "/control_status.csv")):
+    row = {k.split(" [")[0]: v for k, v in r.items()}  # "ref_vn [m/s]" -> "ref_vn"
     v = [float(row[k]) for k in ("ref_vn", "ref_ve", "ref_vd")]
     if row["mode"] in ("1", "2") and all(math.isfinite(x) for x in v):
         fastest = max(fastest, math.sqrt(sum(x * x for x in v)))

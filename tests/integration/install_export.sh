@@ -109,7 +109,9 @@ PYTHONPATH=$PREFIX/share/ofn/python /usr/bin/python3 "$REPO/examples/python/nav_
 import csv, json, math, struct, sys
 work, types, example = sys.argv[1:4]
 track = json.load(open(f"{work}/track.json"))
-rows = list(csv.DictReader(open(f"{work}/flight/nav_state.csv")))
+# Headers carry units ("north [m]"); the bare names are read.
+rows = [{k.split(" [")[0]: v for k, v in r.items()}
+        for r in csv.DictReader(open(f"{work}/flight/nav_state.csv"))]
 def pos(r): return [float(r["north"]), float(r["east"]), float(r["down"])]
 top = max(math.sqrt(sum(float(r[k]) ** 2 for k in ("vn", "ve", "vd"))) for r in rows)
 close = lambda a, b: all(abs(x - y) <= 1e-6 * max(1.0, abs(y)) for x, y in zip(a, b))

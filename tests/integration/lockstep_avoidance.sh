@@ -16,7 +16,8 @@ ft = 0.3048
 ok = True
 for course, way in (("bench1", "over"), ("bench4", "around")):
     s = json.load(open("%s/%s/summary.json" % (work, course)))
-    rows = list(csv.DictReader(open("%s/%s/nav_state.csv" % (work, course))))
+    rows = [{k.split(" [")[0]: v for k, v in r.items()}  # "down [m]" -> "down"
+            for r in csv.DictReader(open("%s/%s/nav_state.csv" % (work, course)))]
     top = max(-float(r["down"]) for r in rows)
     wide = max(abs(float(r["east"])) for r in rows)
     print("%s: least clearance %.2f m (R_s %.2f m), highest %.1f m, widest %.1f m"

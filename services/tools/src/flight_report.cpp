@@ -115,20 +115,27 @@ class CsvTables {
  public:
   explicit CsvTables(const std::filesystem::path& out)
       : nav_(open_csv(out / "nav_state.csv",
-                      "t,north,east,down,vn,ve,vd,an,ae,ad,roll,pitch,yaw,p,q,r")),
+                      "t [s],north [m],east [m],down [m],vn [m/s],ve [m/s],vd [m/s],an [m/s^2],"
+                      "ae [m/s^2],ad [m/s^2],roll [rad],pitch [rad],yaw [rad],p [rad/s],q [rad/s],"
+                      "r [rad/s]")),
         status_(open_csv(out / "control_status.csv",
-                         "t,mode,mission_id,active_waypoint,ref_n,ref_e,ref_d,ref_vn,ref_ve,"
-                         "ref_vd,ref_an,ref_ae,ref_ad,cmd_an,cmd_ae,cmd_ad,err_n,err_e,err_d,"
-                         "yaw_ref")),
-        command_(open_csv(out / "actuator_cmd.csv", "t,collective,lon_cyclic,lat_cyclic,pedal")),
+                         "t [s],mode,mission_id,active_waypoint,ref_n [m],ref_e [m],ref_d [m],"
+                         "ref_vn [m/s],ref_ve [m/s],ref_vd [m/s],ref_an [m/s^2],ref_ae [m/s^2],"
+                         "ref_ad [m/s^2],cmd_an [m/s^2],cmd_ae [m/s^2],cmd_ad [m/s^2],err_n [m],"
+                         "err_e [m],err_d [m],yaw_ref [rad]")),
+        command_(open_csv(out / "actuator_cmd.csv",
+                          "t [s],collective [rad],lon_cyclic [rad],lat_cyclic [rad],pedal [rad]")),
         heartbeat_(open_csv(out / "heartbeats.csv",
-                            "t,service,state,received,rejected,late,loop_time_mean,loop_time_max,"
-                            "cpu_fraction,unauthenticated")),
-        scan_(open_csv(out / "scan_points.csv", "t,north,east,down")),
-        path_(open_csv(out / "global_path.csv", "t,seq,status,cost,north,east,down")),
-        ref_(open_csv(out / "ref_traj.csv", "t,seq,mode,sample_t,north,east,down")),
+                            "t [s],service,state,received,rejected,late,loop_time_mean [s],"
+                            "loop_time_max [s],cpu_fraction,unauthenticated")),
+        scan_(open_csv(out / "scan_points.csv", "t [s],north [m],east [m],down [m]")),
+        path_(open_csv(out / "global_path.csv",
+                       "t [s],seq,status,cost [m],north [m],east [m],down [m]")),
+        ref_(open_csv(out / "ref_traj.csv",
+                      "t [s],seq,mode,sample_t [s],north [m],east [m],down [m]")),
         stats_(open_csv(out / "solver_stats.csv",
-                        "t,status,iterations,solve_time,max_violation,cost,warm_started")) {}
+                        "t [s],status,iterations,solve_time [s],max_violation,cost,warm_started")) {
+  }
 
   void nav(const NavSample& s) {
     nav_ << s.t;
@@ -181,7 +188,8 @@ class CsvTables {
   }
 
   static void waypoints(const std::filesystem::path& out, const std::optional<mission_t>& mission) {
-    auto f = open_csv(out / "waypoints.csv", "index,north,east,down,capture_radius");
+    auto f =
+        open_csv(out / "waypoints.csv", "index,north [m],east [m],down [m],capture_radius [m]");
     if (!mission) return;
     for (size_t i = 0; i < mission->waypoints.size(); ++i) {
       const auto& w = mission->waypoints[i];
@@ -192,7 +200,8 @@ class CsvTables {
   /// The obstacle database as it stood at the end of the flight.
   static void cuboids(const std::filesystem::path& out, const FlightRecord& record) {
     auto f = open_csv(out / "cuboids.csv",
-                      "t,id,min_n,min_e,min_d,max_n,max_e,max_d,top_observed,confidence");
+                      "t [s],id,min_n [m],min_e [m],min_d [m],max_n [m],max_e [m],max_d [m],"
+                      "top_observed,confidence");
     if (!record.last_cuboids) return;
     for (const auto& c : record.last_cuboids->cuboids)
       f << record.last_cuboids_t << "," << c.id << "," << c.min_corner[0] << "," << c.min_corner[1]

@@ -109,7 +109,11 @@ TEST_F(FlightReport, AHoverIsTabledAndSummarised) {
   EXPECT_EQ(result.events, 301u + 151u + 1u);
   EXPECT_NEAR(result.summary.duration, 3.0, 1e-9);
   EXPECT_FALSE(result.summary.reached_last_waypoint);
-  // One header line, then one row per message.
+  // Headers name their units; one header line, then one row per message.
+  std::ifstream nav_table(out / "nav_state.csv");
+  std::string header;
+  std::getline(nav_table, header);
+  EXPECT_EQ(header.rfind("t [s],north [m],east [m],down [m],vn [m/s],", 0), 0u) << header;
   EXPECT_EQ(lines_of(out / "nav_state.csv"), 1u + 301u);
   EXPECT_EQ(lines_of(out / "control_status.csv"), 1u + 151u);
   // The heartbeat's name quoted as CSV: its line break inside the quotes.

@@ -1,5 +1,6 @@
 #pragma once
-// Turns an LCM log of a flight into CSV files per channel, a summary
+// Turns an LCM log of a flight into CSV files per channel (SI, each header
+// naming its unit: "north [m]"), a summary
 // (summary.json and a one-screen text) and, through plot_flight.py, the
 // flight figure. Used by `ofn_flight_report` and by the lockstep runner.
 
