@@ -52,8 +52,9 @@ struct FlightResult {
 };
 
 /// The planner's word as the controller's PerceptionWatch hears it: a
-/// SOLVER_STATS "path clear" on a map of now, at 10 Hz, until `silent_after`
-/// seconds (a dead optimiser, or a mapper that gets no scans).
+/// SOLVER_STATS "path clear" on a map of now, at 10 Hz, from `speaks_from`
+/// until `silent_after` seconds (a dead optimiser, or a mapper that gets no
+/// scans).
 class PlannerStandIn {
  public:
   PlannerStandIn(sim::Lockstep& lockstep, double silent_after)
@@ -62,11 +63,12 @@ class PlannerStandIn {
         0.1, [this] { publish(); }, "status");
   }
   Node& node() { return node_; }
+  double speaks_from = 0;
 
  private:
   void publish() {
     const Utime now = node_.now();
-    if (to_seconds(now) >= silent_after_) return;
+    if (to_seconds(now) < speaks_from || to_seconds(now) >= silent_after_) return;
     solver_stats_t s{};
     s.utime = now;
     s.status = solver_stats_t::NOT_RUN;
@@ -252,6 +254,42 @@ class BusRecorder {
  private:
   Node node_;
 };
+
+// The planner's first word comes 2 s into the flight: the controller has
+// the mission and flies its hold (a stop from the start speed), and the
+// vehicle follows. Guidance then starts from where the vehicle is, not from
+// where it was anchored when the mission came.
+TEST_F(LockstepServices, GuidanceAfterTheHoldStartsOnTheVehicle) {
+  const Scenario scenario = load_scenario(kOpenScenario);
+  sim::Lockstep lockstep;
+  vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), scenario,
+                                     default_sim_config());
+  uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), kOpenScenario);
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
+  PlannerStandIn planner(lockstep, std::numeric_limits<double>::infinity());
+  planner.speaks_from = 2.0;
+  BusRecorder recorder(lockstep);
+  for (Node* n :
+       {&vehicle.node(), &uplink.node(), &controller.node(), &planner.node(), &recorder.node()})
+    lockstep.add(*n);
+  lockstep.run(to_utime(4.0));
+
+  bool held = false;
+  int guided = 0;
+  for (const auto& st : recorder.status) {
+    if (st.mode == control_status_t::HOLD && st.mission_id >= 0) held = true;
+    if (st.mode != control_status_t::WAYPOINT) continue;
+    const double off =
+        Vec3(st.position_error[0], st.position_error[1], st.position_error[2]).norm();
+    EXPECT_LT(off, 0.1) << "at " << to_seconds(st.utime);
+    ++guided;
+  }
+  EXPECT_TRUE(held);
+  EXPECT_GE(guided, 50);
+  // The vehicle flew the hold: it is past the start, and slower.
+  EXPECT_GT(vehicle.model().state().position.x() - scenario.start_position.x(), 4.0);
+}
 
 TEST_F(LockstepServices, ControllerWithoutMissionHoldsPosition) {
   sim::Lockstep lockstep;

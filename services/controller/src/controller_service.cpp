@@ -516,7 +516,12 @@ void ControllerService::control_step() {
       node_.log().info("guidance resumes at t={:.2f} s: the planner's map is fresh again",
                        to_seconds(now));
     }
-    if (previous == control_status_t::TRAJECTORY || previous == control_status_t::SAFE_STOP)
+    // Guidance resumes from the vehicle after any other reference: a plan,
+    // a stop, or the hold flown while the planner's first word was awaited
+    // (guidance was anchored when the mission came, and the vehicle has
+    // flown the hold's stop since).
+    if (previous == control_status_t::TRAJECTORY || previous == control_status_t::SAFE_STOP ||
+        previous == control_status_t::HOLD)
       guidance_.resync(x.position, x.velocity);
     const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
     active_waypoint_ = g.active_waypoint;
