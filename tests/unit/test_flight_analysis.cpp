@@ -494,10 +494,40 @@ TEST(AnalyseFlight, AMissingSampleIsNoJump) {
   EXPECT_NEAR(analysed(st).max_ref_position_jump, 0.0, 1e-9);
 }
 
+// The reference 5 m off the vehicle (a lapsed reference, an old plan)
+// steps onto it: the controller took over from the vehicle's state, and
+// nothing is chased. Counted, not failed.
+TEST(JudgeFlight, AStepOntoTheVehicleIsAResyncNotAJump) {
+  auto st = plan_at_three_metres_per_second();
+  for (size_t i = 0; i < 120; ++i) {
+    st[i].ref_position.y() += 5.0;
+    st[i].position_error.y() += 5.0;
+  }
+  const FlightSummary s = analysed(st);
+  EXPECT_EQ(s.reference_resyncs, 1);
+  EXPECT_NEAR(s.max_ref_position_jump, 0.0, 1e-9);
+  const Verdict v = judged(s);
+  EXPECT_EQ(v.outcome, Outcome::kSuccess) << (v.failures.empty() ? "" : v.failures[0]);
+  // The same step that leaves the vehicle 5 m off its reference fails.
+  auto away = plan_at_three_metres_per_second();
+  for (size_t i = 120; i < away.size(); ++i) {
+    away[i].ref_position.y() += 5.0;
+    away[i].position_error.y() += 5.0;
+  }
+  const FlightSummary a = analysed(away);
+  EXPECT_EQ(a.reference_resyncs, 0);
+  EXPECT_NEAR(a.max_ref_position_jump, 5.0, 1e-9);
+  EXPECT_EQ(judged(a).outcome, Outcome::kFailure);
+}
+
 TEST(JudgeFlight, AReferenceJumpFails) {
   auto st = plan_at_three_metres_per_second();
-  // From sample 120 on the reference is 1.5 m further east: a step.
-  for (size_t i = 120; i < st.size(); ++i) st[i].ref_position.y() += 1.5;
+  // From sample 120 on the reference is 1.5 m further east: a step, the
+  // vehicle 1.5 m off it.
+  for (size_t i = 120; i < st.size(); ++i) {
+    st[i].ref_position.y() += 1.5;
+    st[i].position_error.y() += 1.5;
+  }
   const FlightSummary s = analysed(st);
   EXPECT_NEAR(s.max_ref_position_jump, 1.5, 1e-9);
   ASSERT_TRUE(s.max_ref_position_jump_t.has_value());
@@ -505,6 +535,7 @@ TEST(JudgeFlight, AReferenceJumpFails) {
   const Verdict v = judged(s);
   EXPECT_EQ(v.outcome, Outcome::kFailure);
   EXPECT_TRUE(names(v, "reference jump"));
+  EXPECT_EQ(s.reference_resyncs, 0);
   // A step of the velocity is measured too (its limit is the acceleration).
   st = plan_at_three_metres_per_second();
   for (size_t i = 120; i < st.size(); ++i) st[i].ref_velocity.x() += 2.0;
@@ -551,8 +582,10 @@ TEST(AnalyseFlight, SamplesBeforeEngagementAreIgnored) {
   EXPECT_NEAR(s.tracking_max, 0.1, 1e-12);
   const Verdict v = judged(s);
   EXPECT_EQ(v.outcome, Outcome::kSuccess) << (v.failures.empty() ? "" : v.failures[0]);
-  // The same hold samples flown as a plan would fail on both counts.
+  // The same hold samples flown as a plan would fail on both counts (the
+  // vehicle still where it flew the hold when the plan's reference starts).
   for (int i = 0; i < 50; ++i) st[i].mode = control_status_t::WAYPOINT;
+  st[50].position_error = st[50].ref_position - (st[49].ref_position - st[49].position_error);
   const Verdict engaged = judged(analysed(st));
   EXPECT_TRUE(names(engaged, "reference jump"));
   EXPECT_TRUE(names(engaged, "controller command out of its bound"));

@@ -90,7 +90,12 @@ FlightSummary analyse_flight(const std::vector<NavSample>& nav,
       const double velocity_jump = (st.ref_velocity - previous->ref_velocity -
                                     0.5 * dt * (st.ref_acceleration + previous->ref_acceleration))
                                        .norm();
-      if (position_jump > s.max_ref_position_jump) {
+      // Onto the vehicle: the controller took over from where it is, so
+      // nothing is left to chase.
+      const bool onto_vehicle = st.position_error.norm() <= kMaxReferenceJump;
+      if (position_jump > kMaxReferenceJump && onto_vehicle) {
+        ++s.reference_resyncs;
+      } else if (position_jump > s.max_ref_position_jump) {
         s.max_ref_position_jump = position_jump;
         s.max_ref_position_jump_t = st.t;
       }

@@ -421,6 +421,7 @@ nlohmann::ordered_json summary_json(const FlightRecord& record, const Judged& j,
   json["max_ref_position_jump"] = s.max_ref_position_jump;
   json["max_ref_position_jump_t"] = json_number(s.max_ref_position_jump_t);
   json["max_ref_velocity_jump"] = s.max_ref_velocity_jump;
+  json["reference_resyncs"] = s.reference_resyncs;
   json["final_max_speed"] = json_number(s.final_max_speed);
   json["tracking_rms"] = s.tracking_rms;
   json["tracking_max"] = s.tracking_max;
@@ -507,7 +508,10 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
     << j.pseudo_control_bound.vertical / k << ")\n";
   t << "  reference jump    : " << s.max_ref_position_jump / k << " " << unit << ", "
     << s.max_ref_velocity_jump / k << " " << unit << "/s between samples (largest; position bound "
-    << kMaxReferenceJump / k << " " << unit << ")\n";
+    << kMaxReferenceJump / k << " " << unit << ")";
+  if (s.reference_resyncs > 0)
+    t << "; " << s.reference_resyncs << " onto the vehicle (taken over from its state)";
+  t << "\n";
   t << "  tracking error    : RMS " << s.tracking_rms / k << " " << unit << ", max "
     << s.tracking_max / k << " " << unit << "\n";
   if (j.clearance)

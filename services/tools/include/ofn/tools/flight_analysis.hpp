@@ -58,11 +58,18 @@ struct FlightSummary {
   /// CONTROL_STATUS samples beyond what the reference velocity explains
   /// (trapezoidal), while the plan is flown: a discontinuity in the plan.
   /// Measured against the reference's own motion, so it does not grow with
-  /// speed or with a sample that went missing.
+  /// speed or with a sample that went missing. A step that lands the
+  /// reference on the vehicle (the controller taking over from the
+  /// vehicle's state: a lapsed reference, a plan restarted at the measured
+  /// state) is no discontinuity to follow; it is counted in
+  /// reference_resyncs instead.
   double max_ref_position_jump = 0;
   std::optional<double> max_ref_position_jump_t;  // s, time of the later sample
   /// m/s, the same for the reference velocity against its acceleration.
   double max_ref_velocity_jump = 0;
+  /// Steps beyond kMaxReferenceJump after which the reference was within
+  /// kMaxReferenceJump of the vehicle.
+  int reference_resyncs = 0;
   double tracking_rms = 0;  // m, |reference - actual| while flying the plan
   double tracking_max = 0;  // m
 };
