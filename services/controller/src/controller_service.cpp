@@ -438,6 +438,11 @@ void ControllerService::control_step() {
     last_ref_flown_ = false;
     ref_traj_.reset();
     selector_.end_stop();
+    // Its reference models, integrators and flapping state are those of a
+    // vehicle that has since flown on: begun again, as after navigation
+    // was lost (resumed as they were, the pseudo-control hit its bounds
+    // and the vehicle swung to 40 deg of bank).
+    controller_.reset();
     if (guidance_.has_mission()) guidance_.resync(x.position, x.velocity);
   }
   if (mission_pending_) {
