@@ -1,5 +1,6 @@
 #include "ofn/common/clock.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -11,15 +12,32 @@ Utime WallClock::now() const {
       .count();
 }
 
-ScaledWallClock::ScaledWallClock(Utime start, double real_time_factor)
-    : start_(start), factor_(real_time_factor), wall_start_(std::chrono::steady_clock::now()) {
+ScaledWallClock::ScaledWallClock(Utime start, double real_time_factor, double stall,
+                                 WallSource wall)
+    : start_(start),
+      factor_(real_time_factor),
+      stall_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(stall))),
+      wall_(wall),
+      wall_start_(wall()),
+      last_read_(wall_start_) {
   if (!(real_time_factor > 0.0)) throw std::invalid_argument("real-time factor must be > 0");
+  if (!(stall > 0.0)) throw std::invalid_argument("stall time must be > 0");
 }
 
 Utime ScaledWallClock::now() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto wall = wall_();
+  if (wall - last_read_ > stall_) paused_ += wall - last_read_ - stall_;
+  last_read_ = std::max(last_read_, wall);
   const double wall_elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+      std::chrono::duration<double>(last_read_ - wall_start_ - paused_).count();
   return start_ + to_utime(wall_elapsed * factor_);
+}
+
+double ScaledWallClock::paused() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return std::chrono::duration<double>(paused_).count();
 }
 
 std::string ScaledWallClock::describe() const {

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 
 namespace ofn {
@@ -43,18 +44,32 @@ class WallClock final : public Clock {
 };
 
 /// Simulation master clock: starts at `start` and advances at
-/// `real_time_factor` times the wall (steady) clock.
+/// `real_time_factor` times the wall (steady) clock. The simulated world
+/// waits while its simulator does not run: wall time between two reads
+/// beyond `stall` (a stopped or starved process; the simulator reads it at
+/// its physics rate) does not advance the clock past `stall`. Jumping it
+/// instead integrated seconds of the airframe at once on the last command
+/// while every other service's SIM_CLOCK stood still.
 class ScaledWallClock final : public Clock {
  public:
-  ScaledWallClock(Utime start, double real_time_factor);
+  using WallSource = std::chrono::steady_clock::time_point (*)();
+  ScaledWallClock(Utime start, double real_time_factor, double stall = 0.5,
+                  WallSource wall = &std::chrono::steady_clock::now);
   Utime now() const override;
   double wall_seconds_per_clock_second() const override { return 1.0 / factor_; }
   std::string describe() const override;
+  /// Wall seconds the clock has waited out so far.
+  double paused() const;
 
  private:
   Utime start_;
   double factor_;
+  std::chrono::steady_clock::duration stall_;
+  WallSource wall_;
   std::chrono::steady_clock::time_point wall_start_;
+  mutable std::mutex mutex_;
+  mutable std::chrono::steady_clock::time_point last_read_;
+  mutable std::chrono::steady_clock::duration paused_{0};
 };
 
 /// Follows the SIM_CLOCK messages of the simulation master.
