@@ -158,8 +158,12 @@ int main(int argc, char** argv) {
       const ofn::Utime now = lockstep.clock().now();
       if (!quiet && ofn::to_seconds(now) >= next_progress) {
         const auto& s = vehicle.model().state();
-        std::printf("t=%6.1f s  north %8.1f m  alt %6.1f m  speed %5.2f m/s\n",
-                    ofn::to_seconds(now), s.position.x(), -s.position.z(), s.velocity.norm());
+        // In the course's unit, as the summary that follows.
+        const double k = scenario.metres_per_unit;
+        const char* unit = scenario.display_unit.c_str();
+        std::printf("t=%6.1f s  north %8.1f %s  alt %6.1f %s  speed %5.2f %s/s\n",
+                    ofn::to_seconds(now), s.position.x() / k, unit, -s.position.z() / k, unit,
+                    s.velocity.norm() / k, unit);
         std::fflush(stdout);
         next_progress += 10.0;
       }
