@@ -4,6 +4,7 @@
 
 #include "ofn/actuator_cmd_t.hpp"
 #include "ofn/common/channels.hpp"
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
 #include "ofn/control_status_t.hpp"
@@ -538,8 +539,8 @@ void ControllerService::control_step() {
   }
   if (previous == control_status_t::HOLD && mode_ != control_status_t::HOLD) controller_.reset();
   if (mode_ != previous)
-    node_.log().info("mode {} -> {} at t={:.2f} s", static_cast<int>(previous),
-                     static_cast<int>(mode_), to_seconds(now));
+    node_.log().info("mode {} -> {} at t={:.2f} s", control_mode_name(previous),
+                     control_mode_name(mode_), to_seconds(now));
   const bool looking_around =
       mode_ == control_status_t::TRAJECTORY && ref_traj_ && looks_around(*ref_traj_);
   const double horizontal_speed = std::hypot(x.velocity.x(), x.velocity.y());

@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/control_status_t.hpp"
@@ -83,9 +84,9 @@ int main(int argc, char** argv) {
           const double speed = std::hypot(nav->velocity[0], nav->velocity[1], nav->velocity[2]);
           std::printf(
               "monitor: t=%6.1f s  north %8.1f m  east %6.1f m  alt %6.1f m  speed %5.2f m/s  mode "
-              "%d\n",
+              "%s\n",
               ofn::to_seconds(nav->utime), nav->position[0], nav->position[1], -nav->position[2],
-              speed, static_cast<int>(mode));
+              speed, mode < 0 ? "-" : ofn::control_mode_name(mode));
           std::fflush(stdout);
         },
         "progress");

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/obstacle_messages.hpp"
 #include "ofn/lidar_scan_t.hpp"
 #include "ofn/nav_state_t.hpp"
@@ -170,8 +171,8 @@ void VehicleSimService::on_control_status(const control_status_t& m) {
   // stopping distance ahead, and the first plan then began that far away.
   if (m.mission_id >= 0) {
     released_ = true;
-    node_.log().info("controller engaged at t={:.2f} s (mode {}): vehicle released",
-                     to_seconds(node_.now()), static_cast<int>(m.mode));
+    node_.log().info("controller engaged at t={:.2f} s ({}): vehicle released",
+                     to_seconds(node_.now()), control_mode_name(m.mode));
   }
 }
 

@@ -135,10 +135,4 @@ class ViewState {
         last_grid_ = INT64_MIN, last_mission_ = INT64_MIN, last_obstacles_ = INT64_MIN;
 };
 
-/// Names of the enumerations the page shows.
-const char* control_mode_name(int mode);
-const char* ref_traj_mode_name(int mode);
-const char* solver_status_name(int status);
-const char* path_status_name(int status);
-
 }  // namespace ofn::viewer
