@@ -446,7 +446,7 @@ void ControllerService::control_step() {
     controller_.reset();
     if (guidance_.has_mission()) guidance_.resync(x.position, x.velocity);
   }
-  if (mission_pending_) {
+  if (mission_arrived) {
     guidance_.set_mission(waypoints_from(*mission_), mission_->cruise_speed,
                           limits_from(mission_->limits), x.position, x.velocity);
     mission_pending_ = false;

@@ -334,12 +334,11 @@ class LogDecoder {
   Utime t0_;
 };
 
-/// Reads the log into `record` and the tables. Events before the first
-/// navigation sample have no time base yet; they are kept until it comes.
-void read_log(const std::string& log_path, FlightRecord& record, CsvTables& tables,
-              ReportResult& result) {
-  lcm::LogFile log(log_path, "r");
-  if (!log.good()) throw std::invalid_argument("cannot read LCM log " + log_path);
+/// Reads the log (opened from `log_path`) into `record` and the tables.
+/// Events before the first navigation sample have no time base yet; they
+/// are kept until it comes.
+void read_log(lcm::LogFile& log, const std::string& log_path, FlightRecord& record,
+              CsvTables& tables, ReportResult& result) {
   std::optional<LogDecoder> decoder;
   std::vector<lcm::LogEvent> held;
   std::vector<std::vector<uint8_t>> held_data;
@@ -559,8 +558,9 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
                                  const std::optional<Scenario>& scenario,
                                  const PseudoControlBound& pseudo_control_bound) {
   namespace fs = std::filesystem;
-  if (!lcm::LogFile(log_path, "r").good())
-    throw std::invalid_argument("cannot read LCM log " + log_path);
+  // Checked before any folder or file is made.
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) throw std::invalid_argument("cannot read LCM log " + log_path);
   const fs::path out(out_dir);
   fs::create_directories(out);
 
@@ -568,7 +568,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   FlightRecord record;
   {
     CsvTables tables(out);
-    read_log(log_path, record, tables, result);
+    read_log(log, log_path, record, tables, result);
   }
   CsvTables::waypoints(out, record.mission);
   CsvTables::cuboids(out, record);
