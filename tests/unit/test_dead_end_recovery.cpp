@@ -149,6 +149,19 @@ std::vector<Vec3> route_out_of_the_u(const Vec3& from) {
   return points;
 }
 
+// The verdict knows an escape by its mark; a blind step in the middle of an
+// escape (the map starved, the controller flying the escape's stop) keeps
+// it, or the escape's backward flight would be judged as a forward leg's.
+TEST(RecoveryMessage, MarksEveryStepOfAnEscapeOnce) {
+  EXPECT_EQ(recovery_message(RecoveryPhase::kEscaping, "solved"), "escaping: solved");
+  EXPECT_EQ(recovery_message(RecoveryPhase::kEscaping, "map starved of scans: 17 %"),
+            "escaping: map starved of scans: 17 %");
+  EXPECT_EQ(recovery_message(RecoveryPhase::kEscaping, "escaping: braking"), "escaping: braking");
+  for (RecoveryPhase other : {RecoveryPhase::kIdle, RecoveryPhase::kLooking,
+                              RecoveryPhase::kTurning, RecoveryPhase::kNoRoute})
+    EXPECT_EQ(recovery_message(other, "nav stale"), "nav stale") << to_string(other);
+}
+
 TEST(DeadEndRecovery, LooksAroundOnlyAfterHoveringWithoutAPlanForTheStuckTime) {
   RecoveryRun r;
   EXPECT_EQ(r.run(3.9).phase, RecoveryPhase::kIdle);

@@ -21,6 +21,12 @@ const char* to_string(RecoveryPhase phase) {
   return "?";
 }
 
+std::string recovery_message(RecoveryPhase phase, const std::string& message) {
+  constexpr const char* kMark = "escaping: ";
+  if (phase != RecoveryPhase::kEscaping || message.rfind(kMark, 0) == 0) return message;
+  return kMark + message;
+}
+
 std::optional<size_t> escape_leg_end(const std::vector<Vec3>& route, const GuidanceFrame& leg,
                                      double min_length, double corner_angle) {
   const auto end = forward_from(route, leg);

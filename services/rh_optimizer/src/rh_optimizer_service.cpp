@@ -451,7 +451,7 @@ void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::stri
   s.guidance_clear = guidance_clear && field_valid_;
   s.utime = now;
   s.status = status;
-  s.message = message;
+  s.message = recovery_message(recovery_.phase(), message);
   if (report) {
     s.iterations = report->iterations;
     s.solve_time = report->solve_time;
@@ -668,7 +668,7 @@ void RhOptimizerService::tick() {
                                                        config_.sample_period, now));
   last_trajectory_ = out.trajectory;
   last_trajectory_t0_ = t0;
-  std::string message = std::string(escaping ? "escaping: " : "") + to_string(out.mode);
+  std::string message = recovery_message(recovery.phase, to_string(out.mode));
   if (!out.reason.empty()) message += ": " + out.reason;
   if (out.mode == StepMode::kSolved && out.refused > 0)
     message += (out.reason.empty() ? ": " : "; ") + std::string("the commit gate refused ") +
