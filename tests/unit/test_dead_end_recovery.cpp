@@ -182,6 +182,39 @@ TEST(DeadEndRecovery, LooksAroundOnlyAfterHoveringWithoutAPlanForTheStuckTime) {
   EXPECT_EQ(guided.run(10).phase, RecoveryPhase::kIdle);
 }
 
+// A livelock (dense seed 18 over a bad link hovered 57 s so): every step
+// commits a plan that moves off, the next replaces it before the vehicle
+// has gone anywhere. The vehicle's own progress decides, not the plans'.
+TEST(DeadEndRecovery, AVehicleThatStaysPutIsStuckWhateverThePlansSay) {
+  RecoveryRun r;
+  r.in.moving_plan = true;
+  r.in.velocity = Vec3(0.2, 0, 0);  // drifting about the spot, below the hover speed
+  EXPECT_EQ(r.run(19.8).phase, RecoveryPhase::kIdle);
+  RecoveryDecision d = r.step();
+  if (!d.changed) d = r.step();
+  if (!d.changed) d = r.step();
+  EXPECT_EQ(d.phase, RecoveryPhase::kLooking);
+  EXPECT_NE(d.reason.find("no progress"), std::string::npos) << d.reason;
+
+  // Slow flight that gets somewhere is progress: 0.25 m/s for a minute.
+  RecoveryRun slow;
+  slow.in.moving_plan = true;
+  slow.in.velocity = Vec3(0.25, 0, 0);
+  for (int k = 0; k < 600; ++k) {
+    slow.in.position.x() += 0.025;
+    ASSERT_EQ(slow.step().phase, RecoveryPhase::kIdle) << "at " << slow.in.time << " s";
+  }
+  // And the spot is forgotten when guidance takes over: 15 s engaged, 1 s
+  // not, 15 s engaged again at the same spot is not stuck.
+  RecoveryRun interrupted;
+  interrupted.in.moving_plan = true;
+  interrupted.run(15);
+  interrupted.in.engaged = false;
+  interrupted.run(1);
+  interrupted.in.engaged = true;
+  EXPECT_EQ(interrupted.run(15).phase, RecoveryPhase::kIdle);
+}
+
 TEST(DeadEndRecovery, TheLookEndsAfterAFullTurnAndARouteMadeSince) {
   RecoveryRun r;
   r.run(4.1);

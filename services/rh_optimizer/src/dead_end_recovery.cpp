@@ -84,6 +84,7 @@ void DeadEndRecovery::enter(RecoveryPhase phase, std::string reason) {
       !(phase == RecoveryPhase::kTurning && after_turn_ == RecoveryPhase::kEscaping))
     decision_.escape_route.clear();
   stuck_since_.reset();
+  near_spot_.reset();
 }
 
 void DeadEndRecovery::begin_turn(const RecoveryInput& in) {
@@ -107,13 +108,18 @@ bool DeadEndRecovery::turned_through(const RecoveryInput& in) {
          in.time - look_start_ >= settings_.look_timeout;
 }
 
-bool DeadEndRecovery::stuck(const RecoveryInput& in) {
+DeadEndRecovery::Stuck DeadEndRecovery::stuck(const RecoveryInput& in) {
+  if (!near_spot_ || !((in.position - *near_spot_).norm() <= settings_.progress_radius)) {
+    near_spot_ = in.position;
+    near_since_ = in.time;
+  }
+  if (in.time - near_since_ >= settings_.progress_time) return Stuck::kNoProgress;
   if (in.moving_plan || !(in.velocity.norm() < settings_.hover_speed)) {
     stuck_since_.reset();
-    return false;
+    return Stuck::kNo;
   }
   if (!stuck_since_) stuck_since_ = in.time;
-  return in.time - *stuck_since_ >= settings_.stuck_time;
+  return in.time - *stuck_since_ >= settings_.stuck_time ? Stuck::kHovering : Stuck::kNo;
 }
 
 bool DeadEndRecovery::take_route(const RecoveryInput& in) {
@@ -160,6 +166,7 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
     if (decision_.phase != RecoveryPhase::kIdle) enter(RecoveryPhase::kIdle, "avoidance ended");
     attempts_ = 0;
     stuck_since_.reset();
+    near_spot_.reset();
     return decision_;
   }
   auto begin_look = [&](const char* why) {
@@ -179,7 +186,16 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
 
   switch (decision_.phase) {
     case RecoveryPhase::kIdle:
-      if (stuck(in)) begin_look("no way forward");
+      switch (stuck(in)) {
+        case Stuck::kHovering:
+          begin_look("no way forward");
+          break;
+        case Stuck::kNoProgress:
+          begin_look("no progress (the plans move off, the vehicle stays)");
+          break;
+        case Stuck::kNo:
+          break;
+      }
       break;
     case RecoveryPhase::kLooking:
       if (!look_end_) {
@@ -216,7 +232,7 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
         // planning when it advances from here.
         attempts_ = 0;
         if (!take_route(in)) enter(RecoveryPhase::kIdle, "escape leg done: normal planning");
-      } else if (stuck(in))
+      } else if (stuck(in) != Stuck::kNo)
         begin_look("the escape is stuck");
       break;
     case RecoveryPhase::kNoRoute:

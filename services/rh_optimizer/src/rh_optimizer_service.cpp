@@ -139,6 +139,8 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
     d.enabled = v.boolean("enabled", d.enabled);
     d.stuck_time = v.number_in("stuck_time", d.stuck_time, 0.5, 60.0);
     d.hover_speed = v.number_in("hover_speed", d.hover_speed, 0.01, 5.0);
+    d.progress_time = v.number_in("progress_time", d.progress_time, 1.0, 600.0);
+    d.progress_radius = v.number_in("progress_radius", d.progress_radius, 0.1, 100.0);
     d.look_timeout = v.number_in("look_timeout", d.look_timeout, 1.0, 300.0);
     d.route_wait = v.number_in("route_wait", d.route_wait, 0.0, 60.0);
     d.route_timeout = v.number_in("route_timeout", d.route_timeout, 0.0, 300.0);

@@ -4,8 +4,11 @@
 // than the map or a gap that has closed, no forward plan with a safe stop
 // exists, the commit gate lets only stops through and the vehicle hovers for
 // ever. This core decides what to do then:
-//  1. stuck: avoidance is engaged, the vehicle hovers and no moving plan
-//     has been committed for `stuck_time`;
+//  1. stuck: avoidance is engaged, and the vehicle hovers with no moving
+//     plan committed for `stuck_time`, or, whatever the plans say, it has
+//     stayed within `progress_radius` of one spot for `progress_time` (a
+//     livelock: each step commits a plan that moves off, the next replaces
+//     it before the vehicle has gone anywhere);
 //  2. look around: hover and turn the heading through a full turn, so that
 //     the scanner (which sees only +-20 deg about the heading) maps what is
 //     beside and behind the vehicle, and the global planner re-plans on it;
@@ -35,13 +38,15 @@ namespace ofn::rh {
 
 struct RecoverySettings {
   bool enabled = true;
-  double stuck_time = 4.0;      // s hovering without a moving plan before the look-around
-  double hover_speed = 0.3;     // m/s below which the vehicle counts as hovering
-  double look_turn = 6.2832;    // rad of heading the look-around turns through (a full turn)
-  double look_timeout = 40.0;   // s; the look ends then, turned through or not
-  double route_wait = 3.0;      // s after the look for the map and the route to take it in
-  double route_timeout = 10.0;  // s after the look without a newer route: no route
-  double capture_radius = 3.0;  // m from the escape point at which the escape is done
+  double stuck_time = 4.0;       // s hovering without a moving plan before the look-around
+  double hover_speed = 0.3;      // m/s below which the vehicle counts as hovering
+  double progress_time = 20.0;   // s within progress_radius of one spot: stuck, whatever the plans
+  double progress_radius = 3.0;  // m
+  double look_turn = 6.2832;     // rad of heading the look-around turns through (a full turn)
+  double look_timeout = 40.0;    // s; the look ends then, turned through or not
+  double route_wait = 3.0;       // s after the look for the map and the route to take it in
+  double route_timeout = 10.0;   // s after the look without a newer route: no route
+  double capture_radius = 3.0;   // m from the escape point at which the escape is done
   double face_tolerance =
       0.26;                // rad; an escape leg starts once the heading is this near its direction
   double face_hold = 1.0;  // s facing the leg before it starts (the scanner clears its shadows)
@@ -128,7 +133,8 @@ class DeadEndRecovery {
 
  private:
   void enter(RecoveryPhase phase, std::string reason);
-  bool stuck(const RecoveryInput& in);
+  enum class Stuck { kNo, kHovering, kNoProgress };
+  Stuck stuck(const RecoveryInput& in);
   /// Starts counting the heading turned (a look, or a turn to face the way on).
   void begin_turn(const RecoveryInput& in);
   /// Adds the heading turned since the last update; true after a full turn
@@ -143,6 +149,10 @@ class DeadEndRecovery {
   RecoverySettings settings_;
   RecoveryDecision decision_;
   std::optional<double> stuck_since_;
+  // The spot the vehicle has stayed near since `near_since_` (reset when it
+  // moves farther than progress_radius from it, and on every phase change).
+  std::optional<Vec3> near_spot_;
+  double near_since_ = 0;
   double turned_ = 0;  // rad of heading turned since the look began
   double last_yaw_ = 0;
   double look_start_ = 0;
