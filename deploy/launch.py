@@ -92,10 +92,11 @@ POLL_INTERVAL_S = 0.05
 RESOURCE_PERIOD_S = 1.0
 RESOURCE_SETTLE_S = 60.0
 
-PLACEHOLDERS = ("bin", "scenario", "rtf", "lcm_url", "timeout", "log_dir")
+PLACEHOLDERS = ("bin", "scenario", "rtf", "lcm_url", "timeout", "log_dir", "flight_dir")
 # The option that sets each placeholder, for error messages.
 PLACEHOLDER_OPTIONS = {"bin": "--bin", "scenario": "--scenario", "rtf": "--rtf",
-                       "lcm_url": "--lcm-url", "timeout": "--timeout", "log_dir": "--log-dir"}
+                       "lcm_url": "--lcm-url", "timeout": "--timeout", "log_dir": "--log-dir",
+                       "flight_dir": "--log-dir"}
 # "{name}" but not "${name}", so shell snippets in commands keep working.
 PLACEHOLDER_RE = re.compile(r"(?<!\$)\{([A-Za-z_][A-Za-z0-9_]*)\}")
 NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
@@ -883,6 +884,9 @@ def main(argv=None):
     scenario = os.path.abspath(os.path.expanduser(args.scenario))
     bin_dir = os.path.abspath(os.path.expanduser(args.bin))
     log_dir = os.path.abspath(os.path.expanduser(args.log_dir))
+    # Named now, made once the checks pass: bad input creates nothing.
+    stem = unique_log_stem(log_dir)
+    service_log_dir = os.path.join(log_dir, stem)
 
     values = {
         "bin": bin_dir,
@@ -891,6 +895,7 @@ def main(argv=None):
         "lcm_url": args.lcm_url,
         "timeout": format_number(args.timeout),
         "log_dir": log_dir,
+        "flight_dir": service_log_dir,
         # Not a placeholder: expand_command adds --bus-keys/--bus-role.
         "bus_keys": os.path.abspath(os.path.expanduser(args.bus_keys)) if args.bus_keys else "",
     }
@@ -914,8 +919,6 @@ def main(argv=None):
 
     try:
         os.makedirs(log_dir, exist_ok=True)
-        stem = unique_log_stem(log_dir)
-        service_log_dir = os.path.join(log_dir, stem)
         os.makedirs(service_log_dir)
     except OSError as e:
         sys.stderr.write("launch.py: error: --log-dir: cannot create %s: %s\n" % (log_dir, e.strerror))

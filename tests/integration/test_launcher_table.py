@@ -401,6 +401,38 @@ class SupervisionTest(LauncherTestCase):
         self.assertEqual(lines.count("flapper up"), 3)
         self.assertEqual(len([l for l in lines if l.startswith("=== launcher")]), 3)
 
+    def test_flight_dir_is_the_flights_own_and_outlives_a_restart(self):
+        # What a restarted service resumes from (vehicle_sim's checkpoint)
+        # lives in {flight_dir}: the same directory for every start of the
+        # flight, a new one for the next flight.
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: saver
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "echo start >> {flight_dir}/state; sleep 0.2; exit 1"]
+                restart: true
+              - name: monitor
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "sleep 3"]
+                ends_run: true
+            """)
+        for flight in (1, 2):
+            result = self.run_launcher(table, "--max-restarts", "2", "--timeout", "30")
+            self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        runs = sorted(d for d in os.listdir(self.log_dir) if d.startswith("flight-"))
+        self.assertEqual(len(runs), 2)
+        for run in runs:
+            with open(os.path.join(self.log_dir, run, "state")) as f:
+                starts = f.read().split()
+            # Restarted at least once within the flight, and each flight's
+            # file holds its own starts only (at most 1 + 2 restarts).
+            self.assertGreaterEqual(len(starts), 2, run)
+            self.assertLessEqual(len(starts), 3, run)
+
     def test_sleep_ends_run_with_code_zero(self):
         table = self.write_table("""\
             hosts:

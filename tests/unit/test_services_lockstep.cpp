@@ -688,6 +688,57 @@ TEST_F(LockstepServices, VehicleSimIsReleasedByAControllerWithAMission) {
   EXPECT_GT(nav.back().position[0] - start.x(), 0.5 * open.start_velocity.x());
 }
 
+// A vehicle_sim killed and restarted goes on with the same flight from its
+// checkpoint: the clock from where it stopped, the aircraft where it was and
+// as it moved. A new world at the course's start under services flying the
+// old one made the fault suite's restart row jump 88.6 ft.
+TEST_F(LockstepServices, ARestartedVehicleSimResumesTheFlightFromItsCheckpoint) {
+  const Scenario open = load_scenario(kOpenScenario);
+  auto config = default_sim_config();
+  config.hold_until_engaged = false;  // flying from the start, on its trim
+  sim::Lockstep first;
+  vehicle::VehicleSimService original(first.lcm(), first.clock(), open, config);
+  std::vector<vehicle::VehicleCheckpoint> saved;
+  original.set_checkpoint_sink([&](const vehicle::VehicleCheckpoint& c) { saved.push_back(c); });
+  first.add(original.node());
+  first.run(to_utime(2.0));
+  ASSERT_GE(saved.size(), 15u);  // every 0.1 s
+  const vehicle::VehicleCheckpoint checkpoint = saved.back();
+  EXPECT_GT(to_seconds(checkpoint.time_us), 1.8);
+  EXPECT_TRUE(checkpoint.released);
+  EXPECT_GT(checkpoint.state.position.x() - open.start_position.x(), 3.0);
+
+  // The restart: its clock starts at the checkpoint's time.
+  sim::Lockstep second;
+  second.clock().set(checkpoint.time_us);
+  vehicle::VehicleSimService restarted(second.lcm(), second.clock(), open, config, 1.0, checkpoint);
+  Node listener("listener", second.lcm(), second.clock());
+  std::vector<nav_state_t> nav;
+  std::vector<sim_clock_t> ticks;
+  listener.subscribe<nav_state_t>(channels::kNavState,
+                                  [&](const nav_state_t& m) { nav.push_back(m); });
+  listener.subscribe<sim_clock_t>(channels::kSimClock,
+                                  [&](const sim_clock_t& m) { ticks.push_back(m); });
+  second.add(restarted.node());
+  second.add(listener);
+  const Utime resumed_until = checkpoint.time_us + to_utime(1.0);
+  second.run(resumed_until);
+  ASSERT_GE(nav.size(), 90u);
+  ASSERT_FALSE(ticks.empty());
+  EXPECT_GE(ticks.front().utime, checkpoint.time_us);
+  EXPECT_GE(ticks.front().step, checkpoint.steps);
+  EXPECT_LT(nav.front().position[0] - checkpoint.state.position.x(), 0.1);
+  EXPECT_GT(nav.front().position[0] - checkpoint.state.position.x(), -0.1);
+
+  // And it flies on as the original does over the same second (the same
+  // trim and no wind: the two agree to centimetres).
+  first.run(resumed_until);
+  const Vec3 original_at = original.model().state().position;
+  const Vec3 restarted_at = restarted.model().state().position;
+  EXPECT_LT((original_at - restarted_at).norm(), 0.05)
+      << "original " << original_at.transpose() << ", restarted " << restarted_at.transpose();
+}
+
 TEST_F(LockstepServices, VehicleSimRefusesActuatorCommandsBeyondTheAirframesRange) {
   sim::Lockstep lockstep;
   const Scenario open = load_scenario(kOpenScenario);

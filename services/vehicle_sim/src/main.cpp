@@ -14,10 +14,14 @@ int main(int argc, char** argv) {
   ofn::CommonOptions options;
   std::string scenario_path;
   double real_time_factor = 1.0;
+  std::string checkpoint_path;
   ofn::add_common_options(app, options, /*with_clock=*/false);
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")->required();
   app.add_option("--real-time-factor", real_time_factor, "simulation speed, 1 = real time")
       ->check(CLI::Range(0.01, 1000.0));
+  app.add_option("--checkpoint", checkpoint_path,
+                 "file the flight's state is saved to as it flies; when it exists at the start, "
+                 "the flight resumes from it (a restart after a crash)");
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_vehicle_sim", [&] {
@@ -25,9 +29,17 @@ int main(int argc, char** argv) {
     auto reader = options.config.empty() ? ofn::YamlReader::empty("(defaults)")
                                          : ofn::YamlReader::load_file(options.config);
     auto config = ofn::vehicle::load_vehicle_sim_config(reader);
+    const auto resume = checkpoint_path.empty()
+                            ? std::nullopt
+                            : ofn::vehicle::read_checkpoint_file(checkpoint_path);
     auto lcm = ofn::open_lcm(options);
-    ofn::ScaledWallClock clock(0, real_time_factor);
-    ofn::vehicle::VehicleSimService service(*lcm, clock, scenario, config, real_time_factor);
+    ofn::ScaledWallClock clock(resume ? resume->time_us : 0, real_time_factor);
+    ofn::vehicle::VehicleSimService service(*lcm, clock, scenario, config, real_time_factor,
+                                            resume);
+    if (!checkpoint_path.empty())
+      service.set_checkpoint_sink([&checkpoint_path](const ofn::vehicle::VehicleCheckpoint& c) {
+        ofn::vehicle::write_checkpoint_file(checkpoint_path, c);
+      });
     service.node().log().info("scenario '{}', clock {}", scenario.name, clock.describe());
     return ofn::run_nodes(*lcm, clock, {&service.node()});
   });

@@ -67,6 +67,7 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
   c.command_timeout = r.number_in("command_timeout", c.command_timeout, 0.01, 60.0);
   c.hold_until_engaged = r.boolean("hold_until_engaged", c.hold_until_engaged);
   c.engage_timeout = r.number_in("engage_timeout", c.engage_timeout, 0.0, 3600.0);
+  c.checkpoint_period = r.number_in("checkpoint_period", c.checkpoint_period, 0.01, 60.0);
   YamlReader airframe = r.child("airframe");
   auto& p = c.params;
   p.mass = airframe.number_in("mass", p.mass, 1.0, 1e4);
@@ -89,7 +90,8 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
 }
 
 VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Scenario& scenario,
-                                     VehicleSimConfig config, double real_time_factor)
+                                     VehicleSimConfig config, double real_time_factor,
+                                     std::optional<VehicleCheckpoint> resume)
     : node_("vehicle_sim", lcm, clock),
       config_(std::move(config)),
       real_time_factor_(real_time_factor),
@@ -108,6 +110,10 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
   vehicle_.reset(start_state_, 0.0);
   vehicle_.set_command(trim_controls_);
   released_ = !config_.hold_until_engaged;
+  if (resume) {
+    resume_ = *resume;
+    released_ = resume->released;
+  }
   const auto& v = scenario.vehicle;
   const auto& d = scenario.disturbances;
   if (v.mass_scale != 1.0 || v.inertia_scale != Vec3::Ones() || v.actuator_time_scale != 1.0)
@@ -213,7 +219,21 @@ void VehicleSimService::publish_scan(const LidarScan& scan) {
 void VehicleSimService::step_physics() {
   const Utime now = node_.now();
   const Utime dt_us = to_utime(1.0 / config_.physics_rate);
-  if (state_time_ == INT64_MIN) {
+  if (state_time_ == INT64_MIN && resume_) {
+    // The same flight, on: the state and the time it was saved at (the
+    // clock starts there), the controls as they stood.
+    state_time_ = resume_->time_us;
+    hold_started_ = state_time_;
+    steps_ = resume_->steps;
+    vehicle_.reset(resume_->state, to_seconds(state_time_));
+    vehicle_.set_command(resume_->state.actuators);
+    const Vec3& p = resume_->state.position;
+    node_.log().warn(
+        "resumed from the checkpoint at t={:.2f} s: position ({:.1f}, {:.1f}, {:.1f}) m, "
+        "speed {:.2f} m/s, {}",
+        to_seconds(state_time_), p.x(), p.y(), p.z(), resume_->state.velocity.norm(),
+        released_ ? "released" : "holding");
+  } else if (state_time_ == INT64_MIN) {
     state_time_ = now;
     hold_started_ = now;
     vehicle_.reset(start_state_, to_seconds(now));
@@ -273,6 +293,23 @@ void VehicleSimService::publish_nav() {
   clock.real_time_factor = real_time_factor_;
   clock.step = steps_;
   node_.publish(channels::kSimClock, clock);
+
+  if (checkpoint_sink_ && (last_checkpoint_ == INT64_MIN ||
+                           state_time_ - last_checkpoint_ >= to_utime(config_.checkpoint_period))) {
+    last_checkpoint_ = state_time_;
+    try {
+      checkpoint_sink_(VehicleCheckpoint{state_time_, steps_, released_, vehicle_.model().state()});
+      checkpoint_failing_ = false;
+    } catch (const std::exception& e) {
+      // The flight goes on without it; said once per run of failures.
+      if (!checkpoint_failing_) node_.log().warn("checkpoint not saved: {}", e.what());
+      checkpoint_failing_ = true;
+    }
+  }
+}
+
+void VehicleSimService::set_checkpoint_sink(CheckpointSink sink) {
+  checkpoint_sink_ = std::move(sink);
 }
 
 }  // namespace ofn::vehicle

@@ -5,11 +5,14 @@
 // The scenario sets the airframe's deviation from the configured one, the
 // wind and turbulence, and the navigation solution's noise and latency.
 
+#include <functional>
+#include <optional>
 #include <string>
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/vehicle_sim/checkpoint.hpp"
 #include "ofn/vehicle_sim/disturbances.hpp"
 #include "ofn/vehicle_sim/lidar_head.hpp"
 #include "ofn/vehicle_sim/rotorcraft_simulation.hpp"
@@ -29,6 +32,8 @@ struct VehicleSimConfig {
   bool hold_until_engaged = true;
   /// Release the hold after this long anyway (s of clock time).
   double engage_timeout = 10.0;
+  /// s of clock time between checkpoints (set_checkpoint_sink).
+  double checkpoint_period = 0.1;
   RotorcraftParams params;
   LidarConfig lidar;
 };
@@ -38,8 +43,18 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& reader);
 
 class VehicleSimService {
  public:
+  using CheckpointSink = std::function<void(const VehicleCheckpoint&)>;
+
+  /// `resume`: go on with a saved flight (its state, time and release)
+  /// rather than start the scenario's; the clock must start at its time.
   VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Scenario& scenario,
-                    VehicleSimConfig config, double real_time_factor = 1.0);
+                    VehicleSimConfig config, double real_time_factor = 1.0,
+                    std::optional<VehicleCheckpoint> resume = std::nullopt);
+
+  /// Called with the flight's state every checkpoint_period of clock time
+  /// (main writes it to a file); what it throws is logged, and the flight
+  /// goes on.
+  void set_checkpoint_sink(CheckpointSink sink);
 
   Node& node() { return node_; }
   const RotorcraftSimulation& model() const { return vehicle_.model(); }
@@ -72,6 +87,10 @@ class VehicleSimService {
   LidarHead lidar_;
   int32_t obstacle_revision_ = -1;
   int64_t scans_published_ = 0;
+  std::optional<VehicleCheckpoint> resume_;
+  CheckpointSink checkpoint_sink_;
+  Utime last_checkpoint_ = INT64_MIN;
+  bool checkpoint_failing_ = false;
 };
 
 }  // namespace ofn::vehicle
