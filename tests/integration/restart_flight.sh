@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Killing the controller mid-flight: the launcher restarts it, the restarted
 # controller picks up the mission where the vehicle is, and the flight
-# still completes.
+# still completes. Then killing vehicle_sim: the restarted simulator
+# resumes the same flight from its checkpoint (no jump back to the start).
 source "$(dirname "$0")/common.sh"
 /usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/open.yaml" \
   --bin "$BIN" --rtf 4 --log-dir "$WORK/run" --timeout 150 --no-pin > "$WORK/launch.txt" 2>&1 &
@@ -12,6 +13,9 @@ sleep 6
 # table (the network namespace is private, the PID namespace is not).
 pkill -KILL -P $launcher -f "$BIN/ofn_controller" || fail "no controller process to kill"
 echo "killed the controller"
+sleep 4
+pkill -KILL -P $launcher -f "$BIN/ofn_vehicle_sim" || fail "no vehicle_sim process to kill"
+echo "killed vehicle_sim"
 wait $launcher || { tail -40 "$WORK/launch.txt"; fail "launcher exit code $?"; }
 grep -qi "controller exited" "$WORK/launch.txt" || fail "launcher did not notice the controller exit"
 grep -qi "restarting" "$WORK/launch.txt" || fail "launcher did not restart the controller"
@@ -22,4 +26,9 @@ log=$(cat "$WORK/run/latest_log")
 cat "$WORK/report.txt"
 grep -q "reached the last waypoint, crossed the finish gate" "$WORK/report.txt" ||
   fail "the flight did not complete after the restart"
-pass "controller restarted by the launcher; flight completed"
+grep -q "resumed from the checkpoint" "$WORK/launch.txt" ||
+  fail "the restarted vehicle_sim did not resume from its checkpoint"
+if grep -q "reference jump (" "$WORK/report.txt"; then
+  fail "the reference jumped across the restarts"
+fi
+pass "controller and vehicle_sim restarted by the launcher; the flight went on and completed"
