@@ -14,16 +14,19 @@
 #include "ofn/common/channels.hpp"
 #include "ofn/common/message_names.hpp"
 #include "ofn/common/mission_plan.hpp"
+#include "ofn/common/scenario.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/tools/arrival_watch.hpp"
+#include "ofn/tools/monitor_line.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"ofn flight monitor: progress of a live flight; exits when it is done"};
   ofn::CommonOptions options;
   double timeout = 300.0, report_period = 5.0, linger = 1.0;
+  std::string scenario_path;
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
   app.add_option("--timeout", timeout, "give up after this many wall seconds (0: never)")
       ->check(CLI::NonNegativeNumber);
@@ -33,9 +36,16 @@ int main(int argc, char** argv) {
                  "seconds of flight time over which every status must say DONE, with the "
                  "vehicle at the last waypoint, before the flight counts as arrived")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--scenario", scenario_path,
+                 "scenario file: progress in its unit (feet for the courses); without it, metres");
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_flight_monitor", [&] {
+    ofn::report::DisplayUnit unit;
+    if (!scenario_path.empty()) {
+      const ofn::Scenario scenario = ofn::load_scenario(scenario_path);
+      unit = {scenario.display_unit, scenario.metres_per_unit};
+    }
     auto lcm = ofn::open_lcm(options);
     auto clock = ofn::make_clock(options.clock);
     ofn::Node node("flight_monitor", *lcm, *clock);
@@ -81,13 +91,12 @@ int main(int argc, char** argv) {
             std::cout << "monitor: waiting for NAV_STATE" << std::endl;
             return;
           }
-          const double speed = std::hypot(nav->velocity[0], nav->velocity[1], nav->velocity[2]);
-          std::printf(
-              "monitor: t=%6.1f s  north %8.1f m  east %6.1f m  alt %6.1f m  speed %5.2f m/s  mode "
-              "%s\n",
-              ofn::to_seconds(nav->utime), nav->position[0], nav->position[1], -nav->position[2],
-              speed, mode < 0 ? "-" : ofn::control_mode_name(mode));
-          std::fflush(stdout);
+          std::cout << "monitor: "
+                    << ofn::report::progress_line(
+                           ofn::to_seconds(nav->utime), ofn::to_vec3(nav->position),
+                           ofn::to_vec3(nav->velocity),
+                           mode < 0 ? "-" : ofn::control_mode_name(mode), unit)
+                    << std::endl;
         },
         "progress");
     const auto wall_start = std::chrono::steady_clock::now();
