@@ -12,6 +12,7 @@
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/logging.hpp"
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/controller/controller_service.hpp"
@@ -24,6 +25,7 @@
 #include "ofn/sim/link_faults.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/tools/flight_report.hpp"
+#include "ofn/tools/monitor_line.hpp"
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
 
 namespace {
@@ -158,13 +160,12 @@ int main(int argc, char** argv) {
       const ofn::Utime now = lockstep.clock().now();
       if (!quiet && ofn::to_seconds(now) >= next_progress) {
         const auto& s = vehicle.model().state();
-        // In the course's unit, as the summary that follows.
-        const double k = scenario.metres_per_unit;
-        const char* unit = scenario.display_unit.c_str();
-        std::printf("t=%6.1f s  north %8.1f %s  alt %6.1f %s  speed %5.2f %s/s\n",
-                    ofn::to_seconds(now), s.position.x() / k, unit, -s.position.z() / k, unit,
-                    s.velocity.norm() / k, unit);
-        std::fflush(stdout);
+        // The flight monitor's line, in the course's unit as the summary
+        // that follows.
+        std::cout << ofn::report::progress_line(ofn::to_seconds(now), s.position, s.velocity,
+                                                ofn::control_mode_name(controller.mode()),
+                                                {scenario.display_unit, scenario.metres_per_unit})
+                  << std::endl;
         next_progress += 10.0;
       }
       if (controller.mode() == ofn::control_status_t::DONE && done_at == INT64_MIN) done_at = now;

@@ -1,7 +1,8 @@
 #pragma once
-// The flight monitor's progress line, in the scenario's unit (feet for the
-// benchmark courses, as the summary and the figures are): a user watching a
-// flight compares it with the report, so both speak the same unit. Pure.
+// The progress line of the flight monitor and of the lockstep runner, in the
+// scenario's unit (feet for the benchmark courses, as the summary and the
+// figures are): a user watching a flight compares it with the report, so
+// both speak the same unit. Pure.
 
 #include <string>
 
