@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -166,6 +167,7 @@ TEST(LinkFaults, TheProcessTableGivesEachServiceItsHost) {
   const std::string empty = testing::TempDir() + "/empty_processes.yaml";
   std::ofstream(empty) << "processes: []\n";
   EXPECT_THROW(load_service_hosts(empty), ConfigError);
+  std::remove(empty.c_str());
 }
 
 // Every subscription goes through the link: a message lost on the way is

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -172,7 +173,8 @@ TEST(VehicleVariation, ScalesTheAirframeAndSetsActuatorAuthority) {
   EXPECT_DOUBLE_EQ(m.command().lat_cyclic, -deg2rad(5.0));
 }
 
-std::string write_scenario(const std::string& name, const std::string& extra) {
+// Writes a scenario file, loads it and removes it again.
+Scenario load_written_scenario(const std::string& name, const std::string& extra) {
   // The process id keeps parallel test processes (and parallel builds) apart.
   const std::string path =
       ::testing::TempDir() + "/ofn_" + name + "_" + std::to_string(::getpid()) + ".yaml";
@@ -181,11 +183,15 @@ std::string write_scenario(const std::string& name, const std::string& extra) {
                          "  - position: [100, 0, 100]\nlimits:\n  max_speed: 10\n"
                          "  max_accel: 2\n  max_vertical_speed: 5\n"
                       << extra;
-  return path;
+  struct RemoveOnExit {
+    const std::string& path;
+    ~RemoveOnExit() { std::remove(path.c_str()); }
+  } remove_on_exit{path};
+  return load_scenario(path);
 }
 
 TEST(ScenarioDisturbances, AbsentSectionsAreBenign) {
-  const Scenario s = load_scenario(write_scenario("plain", ""));
+  const Scenario s = load_written_scenario("plain", "");
   EXPECT_EQ(s.vehicle.mass_scale, 1.0);
   EXPECT_EQ(s.vehicle.inertia_scale, Vec3::Ones());
   EXPECT_FALSE(s.vehicle.cyclic_limit.has_value());
@@ -195,7 +201,7 @@ TEST(ScenarioDisturbances, AbsentSectionsAreBenign) {
 }
 
 TEST(ScenarioDisturbances, ReadsEveryFieldInFileUnits) {
-  const Scenario s = load_scenario(write_scenario(
+  const Scenario s = load_written_scenario(
       "full",
       "vehicle:\n  mass_scale: 1.3\n  inertia_scale: [1.1, 1.2, 1.3]\n"
       "  actuator_time_scale: 1.5\n  actuator_limits:\n    collective_deg: [-2, 15]\n"
@@ -203,7 +209,7 @@ TEST(ScenarioDisturbances, ReadsEveryFieldInFileUnits) {
       "    cyclic_rate_deg_s: 50\n    pedal_rate_deg_s: 60\n"
       "disturbances:\n  turbulence_sigma: [3, 2, 1]\n  turbulence_scale: [500, 400, 100]\n"
       "  nav_noise:\n    position: 1\n    velocity: 0.5\n    attitude_deg: 0.3\n"
-      "    rate_deg_s: 0.2\n    latency: 0.04\n  seed: 42\n"));
+      "    rate_deg_s: 0.2\n    latency: 0.04\n  seed: 42\n");
   EXPECT_DOUBLE_EQ(s.vehicle.mass_scale, 1.3);
   EXPECT_DOUBLE_EQ(s.vehicle.inertia_scale.y(), 1.2);
   EXPECT_DOUBLE_EQ(*s.vehicle.collective_min, deg2rad(-2));
@@ -220,7 +226,7 @@ TEST(ScenarioDisturbances, ReadsEveryFieldInFileUnits) {
 TEST(ScenarioDisturbances, MistakesNameTheField) {
   auto error_of = [](const std::string& extra) {
     try {
-      load_scenario(write_scenario("bad", extra));
+      load_written_scenario("bad", extra);
     } catch (const ConfigError& e) {
       return std::string(e.what());
     }
