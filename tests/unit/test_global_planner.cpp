@@ -219,6 +219,39 @@ TEST(GlobalPlanner, TheWayOutOfADeadEndTurnsBack) {
   EXPECT_LE(any.cost, forward.cost + 1e-6);
 }
 
+// An escape stops a few centimetres past the corner it was sent to, within
+// merge_distance of the corner node it must still go round. The corner is
+// not absorbed by the start: the way on stays on this side of the U, it
+// does not flip to the far side (the cul-de-sac trap's 110 s detour).
+TEST(GlobalPlanner, ACornerBesideTheStartIsKept) {
+  const std::vector<ObstacleBox> u = {box(1, 29.0, 94.0, -35.0, -27.0, 180.0, false),
+                                      box(2, 29.0, 94.0, 27.0, 35.0, 180.0, false),
+                                      box(3, 88.0, 94.0, -35.0, 35.0, 180.0, false)};
+  PlanRequest request = course_request(u);
+  GlobalPlannerConfig config;
+  ASSERT_GT(config.merge_distance, 2.0);
+  // The left wall's near outer corner node is at (29 - R_s, -35 - R_s); the
+  // vehicle hovers 2 cm inside its clearance along the leg and 2.8 m short
+  // of it sideways, as the escape left it.
+  const Vec3 corner(29.0 - config.clearance, -35.0 - config.clearance, -kAltitude);
+  request.start = corner + Vec3(0.02, 2.8, 0.0);
+  request.start_velocity = Vec3::Zero();
+  GlobalPlanner planner(config);
+  const PlanResult out = planner.plan_any_direction(request);
+  ASSERT_EQ(out.status, PlanStatus::kOk);
+  for (const Vec3& w : out.waypoints)
+    EXPECT_LE(w.y(), 0.0) << "waypoint " << w.transpose() << " on the far side of the U";
+  // Round the left wall: about its length plus the way to the goal, not
+  // twice across the opening first.
+  EXPECT_LT(out.cost, 150.0);
+  const double margin = config.clearance - config.collision_tolerance - 1e-6;
+  for (const Vec3& p : out.path)
+    for (const ObstacleBox& o : u)
+      EXPECT_FALSE(strictly_inside(p, o.min_corner - Vec3::Constant(margin),
+                                   o.max_corner + Vec3::Constant(margin)))
+          << p.transpose() << " in box " << o.id;
+}
+
 TEST(GlobalPlanner, TwoBoxesAreBothAvoided) {
   const GlobalPlannerConfig config;
   GlobalPlanner planner(config);
