@@ -29,7 +29,7 @@ for seed in $SEEDS; do
   scenarios+=("$WORK/dense-$seed.yaml")
 done
 scenarios+=("$REPO/sim/scenarios/trap_closing_gap.yaml")
-# First, so that its minute of wall time overlaps the others.
+# First: the longest flight here, its wall time overlaps the others.
 scenarios=("$REPO/sim/scenarios/trap_cul_de_sac.yaml" "${scenarios[@]}")
 fly() {
   local name code=0 limit=(--max-time "$MAX_TIME")
