@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+
+#include <fmt/format.h>
 
 #include "ofn/common/channels.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
@@ -449,6 +452,10 @@ RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
 
 void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::string& message,
                                        const SolveReport* report, bool guidance_clear) {
+  if (!step_warned_)
+    for (const std::string& line : warning_streak_.clear(to_seconds(now)))
+      node_.log().warn("{}", line);
+  step_warned_ = false;
   solver_stats_t s{};
   s.guidance_clear = guidance_clear && field_valid_;
   s.utime = now;
@@ -675,10 +682,17 @@ void RhOptimizerService::tick() {
   if (out.mode == StepMode::kSolved && out.refused > 0)
     message += (out.reason.empty() ? ": " : "; ") + std::string("the commit gate refused ") +
                std::to_string(out.refused) + " other plan(s) (" + out.refusal + ")";
-  if (out.mode != StepMode::kSolved)
-    node_.log().warn("t={:.2f} s {} ({} solves, worst violation {:.3g})", t, message, out.solves,
-                     out.report.max_violation);
-  else if (out.refused > 0)
+  if (out.mode != StepMode::kSolved) {
+    // One line per streak of like steps (the first in full, then a
+    // summary); every step's message still goes out in SOLVER_STATS.
+    step_warned_ = true;
+    const std::string text = fmt::format("t={:.2f} s {} ({} solves, worst violation {:.3g})", t,
+                                         message, out.solves, out.report.max_violation);
+    for (const std::string& line :
+         warning_streak_.warn(t, recovery_message(recovery.phase, to_string(out.mode)), text,
+                              out.report.max_violation))
+      node_.log().warn("{}", line);
+  } else if (out.refused > 0)
     node_.log().info("t={:.2f} s {}", t, message);
   else if (out.stalled != stalled_)
     node_.log().info("t={:.2f} s {}", t, out.stalled ? message : "no longer stalled");

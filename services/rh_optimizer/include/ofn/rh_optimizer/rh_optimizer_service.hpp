@@ -14,6 +14,7 @@
 #include "ofn/common/config.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/common/warning_streak.hpp"
 #include "ofn/global_path_t.hpp"
 #include "ofn/mapper/distance_field.hpp"
 #include "ofn/mapper/heightfield.hpp"
@@ -170,7 +171,11 @@ class RhOptimizerService {
   BsplineTrajectory last_trajectory_;  // last published, for a(t0)
   Utime last_trajectory_t0_ = 0;
   bool stopping_at_target_ = false;  // the last plan stops at the last waypoint
-  bool stalled_ = false;             // the last step's warm plan was a stall (logged once)
+  // Failed steps are logged once per streak (common/warning_streak.hpp);
+  // step_warned_: this step's failure was handed to it.
+  WarningStreak warning_streak_;
+  bool step_warned_ = false;
+  bool stalled_ = false;  // the last step's warm plan was a stall (logged once)
   int64_t steps_ = 0;
   int64_t ticks_since_nominal_ = 0;
   std::string last_note_;
