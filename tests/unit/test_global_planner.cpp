@@ -127,6 +127,18 @@ void expect_optimal(const GlobalPlannerConfig& config, const PlanRequest& reques
   }
 }
 
+// Every point of the interpolated path outside each box's clearance
+// (less the tolerance), for paths in any direction.
+void expect_path_clear(const GlobalPlannerConfig& config, const std::vector<ObstacleBox>& boxes,
+                       const PlanResult& result) {
+  const double margin = config.clearance - config.collision_tolerance - 1e-6;
+  for (const Vec3& p : result.path)
+    for (const ObstacleBox& o : boxes)
+      EXPECT_FALSE(strictly_inside(p, o.min_corner - Vec3::Constant(margin),
+                                   o.max_corner + Vec3::Constant(margin)))
+          << p.transpose() << " in box " << o.id;
+}
+
 double highest_altitude(const PlanResult& result) {
   double h = -kInf;
   for (const Vec3& p : result.path) h = std::max(h, -p.z());
@@ -205,12 +217,7 @@ TEST(GlobalPlanner, TheWayOutOfADeadEndTurnsBack) {
   EXPECT_LT(least_north, 30.0);
   EXPECT_EQ(out.path.front(), request.start);
   EXPECT_EQ(out.path.back(), request.goal);
-  const double margin = config.clearance - config.collision_tolerance - 1e-6;
-  for (const Vec3& p : out.path)
-    for (const ObstacleBox& o : u)
-      EXPECT_FALSE(strictly_inside(p, o.min_corner - Vec3::Constant(margin),
-                                   o.max_corner + Vec3::Constant(margin)))
-          << p.transpose() << " in box " << o.id;
+  expect_path_clear(config, u, out);
   // With a route ahead, the search in any direction is no longer.
   const PlanRequest open = course_request({box(1, 60.0, 63.0, -20.0, 20.0, 180.0, false)});
   const PlanResult forward = planner.plan(open), any = planner.plan_any_direction(open);
@@ -244,12 +251,7 @@ TEST(GlobalPlanner, ACornerBesideTheStartIsKept) {
   // Round the left wall: about its length plus the way to the goal, not
   // twice across the opening first.
   EXPECT_LT(out.cost, 150.0);
-  const double margin = config.clearance - config.collision_tolerance - 1e-6;
-  for (const Vec3& p : out.path)
-    for (const ObstacleBox& o : u)
-      EXPECT_FALSE(strictly_inside(p, o.min_corner - Vec3::Constant(margin),
-                                   o.max_corner + Vec3::Constant(margin)))
-          << p.transpose() << " in box " << o.id;
+  expect_path_clear(config, u, out);
 }
 
 TEST(GlobalPlanner, TwoBoxesAreBothAvoided) {
