@@ -4,9 +4,15 @@
 # then killed (kill -9). The controller must fly the last plan's stop and
 # hover rather than waypoint guidance into the wall; the restarted optimiser
 # takes over again. The flight must keep 0.8 R_s from the wall and finish.
+# The ground station's flight monitor must say the optimiser fell silent
+# (its heartbeats stop while it is stopped; the monitor here reports a
+# silence of 2 s of wall time, the default is 3) and heard again.
 source "$(dirname "$0")/common.sh"
 scenario="$REPO/sim/scenarios/bench3.yaml"
-/usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$scenario" \
+sed 's|"--scenario", "{scenario}"\]|"--scenario", "{scenario}", "--silence", "2"]|' \
+  "$REPO/deploy/processes.yaml" > "$WORK/processes.yaml"
+grep -q -- '"--silence", "2"' "$WORK/processes.yaml" || fail "the monitor's command line was not found in deploy/processes.yaml"
+/usr/bin/python3 "$REPO/deploy/launch.py" --table "$WORK/processes.yaml" --scenario "$scenario" \
   --bin "$BIN" --rtf 2 --log-dir "$WORK/run" --timeout 200 --no-pin > "$WORK/launch.txt" 2>&1 &
 launcher=$!
 # Wait for the optimiser to engage (its log line reaches the launcher's output).
@@ -28,6 +34,11 @@ kill -KILL "$pid"
 echo "killed the RH optimiser"
 wait $launcher || { tail -40 "$WORK/launch.txt"; fail "launcher exit code $?"; }
 grep -q "flying its stop" "$WORK/launch.txt" || fail "the controller never flew the plan's stop"
+grep "monitor: no heartbeat\|monitor: heartbeats again" "$WORK/launch.txt" || true
+grep -q "monitor: no heartbeat for 2 s (wall) from: .*rh_optimizer" "$WORK/launch.txt" ||
+  fail "the flight monitor never reported the stopped optimiser silent"
+grep -q "monitor: heartbeats again from: .*rh_optimizer" "$WORK/launch.txt" ||
+  fail "the flight monitor never heard the optimiser again"
 log=$(cat "$WORK/run/latest_log")
 "$BIN/ofn_flight_report" --log "$log" --scenario "$scenario" --out "$WORK/report" \
   > "$WORK/report.txt" || true

@@ -2,12 +2,17 @@
 // exits when the vehicle has arrived at the last waypoint (0: the controller
 // says DONE for --linger seconds while navigation puts the vehicle there,
 // see ArrivalWatch) or when the wall-clock timeout passes (1). The launcher
-// uses it to end a run.
+// uses it to end a run. It also says which services have fallen silent (no
+// heartbeat for --silence wall seconds, see HeartbeatWatch) and when they
+// are heard again.
 
 #include <chrono>
 #include <cmath>
 #include <iostream>
 #include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -17,9 +22,11 @@
 #include "ofn/common/scenario.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/control_status_t.hpp"
+#include "ofn/heartbeat_t.hpp"
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/tools/arrival_watch.hpp"
+#include "ofn/tools/heartbeat_watch.hpp"
 #include "ofn/tools/monitor_line.hpp"
 
 int main(int argc, char** argv) {
@@ -27,6 +34,11 @@ int main(int argc, char** argv) {
   ofn::CommonOptions options;
   double timeout = 300.0, report_period = 5.0, linger = 1.0;
   std::string scenario_path;
+  double silence = 3.0;
+  // The flight's services (deploy/processes.yaml), the monitor excepted.
+  std::vector<std::string> watched = {"vehicle_sim",       "controller",       "mission_uplink",
+                                      "obstacle_injector", "sensor_interface", "mapper",
+                                      "global_planner",    "rh_optimizer"};
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
   app.add_option("--timeout", timeout, "give up after this many wall seconds (0: never)")
       ->check(CLI::NonNegativeNumber);
@@ -38,6 +50,14 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--scenario", scenario_path,
                  "scenario file: progress in its unit (feet for the courses); without it, metres");
+  app.add_option("--silence", silence,
+                 "wall seconds without a heartbeat after which a service is reported silent "
+                 "(0: no report)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--services", watched, "services whose heartbeats are watched")
+      ->delimiter(',')
+      ->capture_default_str();
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_flight_monitor", [&] {
@@ -100,8 +120,35 @@ int main(int argc, char** argv) {
         },
         "progress");
     const auto wall_start = std::chrono::steady_clock::now();
+    auto wall_seconds = [&] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    };
+    std::optional<ofn::report::HeartbeatWatch> heartbeats;
+    if (silence > 0) {
+      heartbeats.emplace(silence);
+      for (const std::string& service : watched)
+        node.subscribe<ofn::heartbeat_t>(
+            ofn::heartbeat_channel(service),
+            [&heartbeats, &wall_seconds, service](const ofn::heartbeat_t&) {
+              heartbeats->heard(service, wall_seconds());
+            },
+            ofn::SubscribeOptions{0.0, 0.0});
+    }
+    auto names = [](const std::vector<std::string>& list) {
+      std::ostringstream out;
+      for (size_t i = 0; i < list.size(); ++i) out << (i ? ", " : "") << list[i];
+      return out.str();
+    };
     bool timed_out = false;
     ofn::run_nodes(*lcm, *clock, {&node}, [&] {
+      if (heartbeats) {
+        const auto changes = heartbeats->check(wall_seconds());
+        if (!changes.silent.empty())
+          std::cout << "monitor: no heartbeat for " << silence
+                    << " s (wall) from: " << names(changes.silent) << std::endl;
+        if (!changes.back.empty())
+          std::cout << "monitor: heartbeats again from: " << names(changes.back) << std::endl;
+      }
       if (arrival.arrived_at()) return false;
       timed_out = timeout > 0 && std::chrono::steady_clock::now() - wall_start >
                                      std::chrono::duration<double>(timeout);
