@@ -14,7 +14,7 @@ namespace {
 using Lines = std::vector<std::string>;
 
 TEST(WarningStreak, ARepeatIsCountedNotLogged) {
-  WarningStreak streak;
+  WarningStreak streak("worst violation");
   EXPECT_EQ(streak.warn(1.0, "kept_previous", "t=1.00 s kept_previous: first", 3.0),
             Lines{"t=1.00 s kept_previous: first"});
   EXPECT_TRUE(streak.warn(1.1, "kept_previous", "t=1.10 s kept_previous: again", 70.0).empty());
@@ -22,7 +22,8 @@ TEST(WarningStreak, ARepeatIsCountedNotLogged) {
   EXPECT_EQ(streak.repeats(), 2);
   const Lines end = streak.clear(1.3);
   ASSERT_EQ(end.size(), 1u);
-  EXPECT_EQ(end[0], "kept_previous: 2 more from t=1.00 to 1.20 s (worst 70), over at t=1.30 s");
+  EXPECT_EQ(end[0],
+            "kept_previous: 2 more from t=1.00 to 1.20 s (worst violation 70), over at t=1.30 s");
   EXPECT_EQ(streak.repeats(), 0);
   // Over: the same kind again begins a new streak, logged in full.
   EXPECT_EQ(streak.warn(2.0, "kept_previous", "t=2.00 s kept_previous: later", 1.0).size(), 1u);

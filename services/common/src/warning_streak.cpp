@@ -33,10 +33,11 @@ std::vector<std::string> WarningStreak::clear(double t) {
 }
 
 std::string WarningStreak::summary(double t) const {
-  char buffer[96];
-  std::snprintf(buffer, sizeof buffer, " more from t=%.2f to %.2f s (worst %.3g), over at t=%.2f s",
-                first_, last_, worst_, t);
-  return kind_ + ": " + std::to_string(repeats_) + buffer;
+  char span[64], worst[32], end[40];
+  std::snprintf(span, sizeof span, " more from t=%.2f to %.2f s (", first_, last_);
+  std::snprintf(worst, sizeof worst, " %.3g)", worst_);
+  std::snprintf(end, sizeof end, ", over at t=%.2f s", t);
+  return kind_ + ": " + std::to_string(repeats_) + span + figure_name_ + worst + end;
 }
 
 }  // namespace ofn

@@ -10,12 +10,17 @@
 // Pure: no logger, no clock; times in seconds of the caller's clock.
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ofn {
 
 class WarningStreak {
  public:
+  /// `figure_name` names the figure in the summary ("worst violation").
+  explicit WarningStreak(std::string figure_name = "worst")
+      : figure_name_(std::move(figure_name)) {}
+
   /// A warning of `kind` (a few words that name it, without numbers) at
   /// time `t`, its full `text`, and a figure to carry to the summary (its
   /// largest is reported, e.g. the worst constraint violation). Returns the
@@ -32,6 +37,7 @@ class WarningStreak {
  private:
   std::string summary(double t) const;
 
+  std::string figure_name_;
   std::string kind_;  // empty: no streak
   double first_ = 0;  // s, the streak's first warning
   double last_ = 0;   // s, its latest

@@ -173,7 +173,7 @@ class RhOptimizerService {
   bool stopping_at_target_ = false;  // the last plan stops at the last waypoint
   // Failed steps are logged once per streak (common/warning_streak.hpp);
   // step_warned_: this step's failure was handed to it.
-  WarningStreak warning_streak_;
+  WarningStreak warning_streak_{"worst violation"};
   bool step_warned_ = false;
   bool stalled_ = false;  // the last step's warm plan was a stall (logged once)
   int64_t steps_ = 0;
