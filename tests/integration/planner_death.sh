@@ -9,7 +9,7 @@
 # silence of 2 s of wall time, the default is 3) and heard again.
 source "$(dirname "$0")/common.sh"
 scenario="$REPO/sim/scenarios/bench3.yaml"
-sed 's|"--scenario", "{scenario}"\]|"--scenario", "{scenario}", "--silence", "2"]|' \
+sed '/ofn_flight_monitor/ s|"--scenario", "{scenario}"\]|"--scenario", "{scenario}", "--silence", "2"]|' \
   "$REPO/deploy/processes.yaml" > "$WORK/processes.yaml"
 grep -q -- '"--silence", "2"' "$WORK/processes.yaml" || fail "the monitor's command line was not found in deploy/processes.yaml"
 /usr/bin/python3 "$REPO/deploy/launch.py" --table "$WORK/processes.yaml" --scenario "$scenario" \
