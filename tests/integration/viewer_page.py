@@ -15,8 +15,10 @@ never gets there within the time limit.
 import base64
 import json
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 LIMIT = 60.0  # s for the whole session; a healthy page needs a second or two
@@ -35,12 +37,18 @@ class Browser:
             os.dup2(to_browser_r, 3)
             os.dup2(from_browser_w, 4)
 
+        # A profile and a temporary folder of its own, removed on close:
+        # left to itself Chromium leaves an org.chromium.Chromium.* folder
+        # in /tmp after every run.
+        self._scratch = tempfile.mkdtemp(prefix="ofn-chromium-")
         self.process = subprocess.Popen(
             ["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
-             "--window-size=1400,900", "--remote-debugging-pipe", "about:blank"],
+             "--window-size=1400,900", "--remote-debugging-pipe",
+             "--user-data-dir=" + os.path.join(self._scratch, "profile"), "about:blank"],
             # The descriptors are put in place after the fork; fds 3 and 4
             # must then stay open, which close_fds would undo.
             close_fds=False, preexec_fn=child_fds,
+            env=dict(os.environ, TMPDIR=self._scratch),
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         os.close(to_browser_r)
         os.close(from_browser_w)
@@ -75,6 +83,7 @@ class Browser:
     def close(self):
         self.process.kill()
         self.process.wait()
+        shutil.rmtree(self._scratch, ignore_errors=True)
 
 
 def main():
