@@ -357,9 +357,13 @@ class Problem {
     std::sort(order.begin(), order.end());
 
     nodes_ = {start_, goal_};
+    // Only corner nodes go into the merge index, so only they absorb their
+    // neighbours. The start and the goal are not corners: a vehicle stopped
+    // 2 m beside the corner it must go round would lose that corner, and
+    // the segment from where it is to the next one cuts the box (seen in
+    // the cul-de-sac: the route flipped to the far side each time the
+    // escape reached a corner).
     merge_index_.clear();
-    add_to_merge_index(0);
-    add_to_merge_index(1);
     for (const auto& entry : order) {
       const Vec3& p = lifted[entry.second];
       if (config_.merge_distance > 0 && has_neighbour(p)) continue;
@@ -428,11 +432,6 @@ class Problem {
     merge_index_[cell_key(nodes_[i], config_.merge_distance, 0, 0, 0)].push_back(i);
   }
 
-  // Only corner nodes absorb their neighbours. The start and the goal are
-  // not corners: a vehicle stopped 2 m beside the corner it must go round
-  // would lose that corner, and the segment from where it is to the next
-  // one cuts the box (seen in the cul-de-sac: the route flipped to the far
-  // side each time the escape reached a corner).
   bool has_neighbour(const Vec3& p) const {
     const double r = config_.merge_distance;
     for (int dx = -1; dx <= 1; ++dx)
@@ -441,7 +440,7 @@ class Problem {
           const auto it = merge_index_.find(cell_key(p, r, dx, dy, dz));
           if (it == merge_index_.end()) continue;
           for (int k : it->second)
-            if (k > 1 && (nodes_[k] - p).squaredNorm() < r * r) return true;
+            if ((nodes_[k] - p).squaredNorm() < r * r) return true;
         }
     return false;
   }
