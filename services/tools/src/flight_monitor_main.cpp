@@ -150,8 +150,7 @@ int main(int argc, char** argv) {
           std::cout << "monitor: heartbeats again from: " << names(changes.back) << std::endl;
       }
       if (arrival.arrived_at()) return false;
-      timed_out = timeout > 0 && std::chrono::steady_clock::now() - wall_start >
-                                     std::chrono::duration<double>(timeout);
+      timed_out = timeout > 0 && wall_seconds() > timeout;
       return !timed_out;
     });
     if (timed_out) {
