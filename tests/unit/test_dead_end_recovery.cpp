@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "ofn/rh_optimizer/dead_end_recovery.hpp"
@@ -71,6 +73,109 @@ TEST(EscapeLeg, FromAHoverJustInsideThePlannedClearance) {
   EXPECT_EQ(out.mode, StepMode::kSolved) << out.reason;
 }
 
+TEST(VerticalMove, FromHoverToHoverWithinTheLimits) {
+  for (const double rise : {0.5, 3.0, 15.0, 60.0, -10.0}) {
+    const Vec3 from(10, -4, -30);
+    const double speed = 1.2, accel = 0.4;
+    const BsplineTrajectory climb = vertical_move(from, from.z() - rise, speed, accel);
+    ASSERT_FALSE(climb.empty()) << rise;
+    const double end = climb.duration();
+    EXPECT_LT((climb.position(0) - from).norm(), 1e-9) << rise;
+    EXPECT_LT((climb.position(end) - Vec3(10, -4, -30 - rise)).norm(), 1e-9) << rise;
+    for (const double t : {0.0, end}) {
+      EXPECT_LT(climb.velocity(t).norm(), 1e-9) << rise;
+      EXPECT_LT(climb.acceleration(t).norm(), 1e-9) << rise;
+    }
+    double peak_speed = 0, peak_accel = 0, off_vertical = 0;
+    for (int k = 0; k <= 1000; ++k) {
+      const double t = end * k / 1000;
+      peak_speed = std::max(peak_speed, climb.velocity(t).norm());
+      peak_accel = std::max(peak_accel, climb.acceleration(t).norm());
+      off_vertical = std::max(off_vertical, (climb.position(t) - from).head<2>().norm());
+    }
+    EXPECT_LE(peak_speed, speed * 1.001) << rise;
+    EXPECT_LE(peak_accel, accel * 1.001) << rise;
+    EXPECT_LT(off_vertical, 1e-9) << rise;
+    // Not much slower than a bang-coast-bang move at the limits.
+    const double d = std::abs(rise);
+    const double fastest =
+        d > speed * speed / accel ? d / speed + speed / accel : 2.0 * std::sqrt(d / accel);
+    EXPECT_LT(end, 1.6 * fastest) << rise;
+  }
+  EXPECT_TRUE(vertical_move(Vec3(0, 0, -30), -30.0, 1.0, 1.0).empty());
+}
+
+// A hover before a wall at R_s plus a metre (the stack's dead-end hover):
+// the climb straight up is committed step after step, and the same plan is
+// flown throughout; from a moving state it brakes first.
+TEST(RhPlannerClimb, FromAHoverBesideAWallTheClimbIsCommittedAndKept) {
+  using testing_support::Box;
+  RhPlanner planner;
+  const Vec3 hover(40.5 - kBenchmarkLimits.clearance - 1.0, 0, -kLegAltitude);
+  StepInput in = escape_leg(hover, hover, field_with({Box{40, 43, -60, 60, 150.0f}}));
+  in.problem.velocity = Vec3::Zero();
+  const double target_z = -(kLegAltitude + 15.0);
+  const StepOutput first = planner.climb(in, target_z);
+  ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
+  EXPECT_TRUE(first.commit.committed);
+  EXPECT_NEAR(first.trajectory.position(first.trajectory.duration()).z(), target_z, 1e-9);
+  EXPECT_NEAR(first.start_time, in.time, 1e-12);
+  // Two seconds on, flying it: the same plan, from the same start.
+  const double later = 2.0;
+  in.time += later;
+  in.problem.position = first.trajectory.position(later);
+  in.problem.velocity = first.trajectory.velocity(later);
+  in.problem.acceleration = first.trajectory.acceleration(later);
+  const StepOutput next = planner.climb(in, target_z);
+  ASSERT_EQ(next.mode, StepMode::kSolved) << next.reason;
+  EXPECT_NEAR(next.start_time, first.start_time, 1e-12);
+  EXPECT_NEAR(next.trajectory.duration(), first.trajectory.duration(), 1e-12);
+  // A new planner, the vehicle still moving: a stop first.
+  RhPlanner fresh;
+  StepInput moving = escape_leg(hover, hover, field_with({}));
+  moving.problem.velocity = Vec3(-0.5, 0, 0);
+  EXPECT_EQ(fresh.climb(moving, target_z).mode, StepMode::kBraking);
+}
+
+// Something mapped above the hover (no obstacle in the grid stands in the
+// air, but the gate does not rely on it): the climb is flown until its stop
+// would come nearer than the gate allows, then the vehicle brakes.
+TEST(RhPlannerClimb, AClimbIntoSomethingMappedAboveIsRefusedInTime) {
+  const double roof_z = -(kLegAltitude + 6.0);  // 6 m above the hover
+  ClearanceQuery roof = [roof_z](const Vec3& p) {
+    mapping::DistanceSample d;
+    d.distance = std::max(0.0, p.z() - roof_z);  // up is -z
+    d.gradient = Vec3(0, 0, 1);
+    return d;
+  };
+  RhPlanner planner;
+  const Vec3 hover(0, 0, -(kLegAltitude - 8.0));  // 14 m under the roof
+  StepInput in = escape_leg(hover, hover, roof);
+  in.problem.velocity = Vec3::Zero();
+  const double target_z = -(kLegAltitude + 20.0);
+  const StepOutput first = planner.climb(in, target_z);
+  ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
+  const BsplineTrajectory plan = first.trajectory;
+  bool braked = false;
+  for (double t = 0.1; t <= plan.duration() && !braked; t += 0.1) {
+    in.time = first.start_time + t;
+    in.problem.position = plan.position(t);
+    in.problem.velocity = plan.velocity(t);
+    in.problem.acceleration = plan.acceleration(t);
+    const StepOutput out = planner.climb(in, target_z);
+    if (out.mode != StepMode::kBraking) continue;
+    braked = true;
+    EXPECT_NE(out.reason.find("refused the climb"), std::string::npos) << out.reason;
+    double highest = 0;  // m above the hover the stop reaches
+    for (int k = 0; k <= 200; ++k)
+      highest = std::max(
+          highest, hover.z() - out.trajectory.position(out.trajectory.duration() * k / 200.0).z());
+    EXPECT_LE(hover.z() - roof_z - highest + 1e-6, 14.0);
+    EXPECT_GE(14.0 - highest, 0.9 * kBenchmarkLimits.clearance - 0.05) << "at t=" << t;
+  }
+  EXPECT_TRUE(braked);
+}
+
 }  // namespace
 }  // namespace ofn::rh
 
@@ -96,12 +201,16 @@ class RecoveryRun {
   explicit RecoveryRun(RecoverySettings s = settings()) : recovery(s) {
     in.engaged = true;
     in.position = Vec3(80, 0, -36.6);
+    in.altitude = 36.6;
+    in.max_vertical_speed = 1.5;
     in.leg = kLeg;
     in.route_points = &route;
   }
   RecoveryDecision step(double dt = 0.1) {
     in.time += dt;
-    return recovery.update(in);
+    RecoveryDecision d = recovery.update(in);
+    if (d.changed) last_reason = d.reason;
+    return d;
   }
   /// Steps for `seconds`, turning the heading at `yaw_rate`.
   RecoveryDecision run(double seconds, double yaw_rate = 0.0) {
@@ -133,6 +242,7 @@ class RecoveryRun {
   DeadEndRecovery recovery;
   RecoveryInput in;
   std::vector<Vec3> route;
+  std::string last_reason;  // of the last phase change
 };
 
 // A route out of a U whose opening is behind the vehicle: back south, then
@@ -293,7 +403,9 @@ TEST(DeadEndRecovery, EscapesLegByLegAlongARouteThatTurnsBack) {
 }
 
 TEST(DeadEndRecovery, NoRouteAfterTheLookHoldsTheHoverAndSaysSo) {
-  RecoveryRun r;
+  RecoverySettings never_climbs = settings();
+  never_climbs.climb_step = 0.0;
+  RecoveryRun r(never_climbs);
   r.run(4.1);
   r.run(2 * M_PI / 0.5 + 0.3, 0.5);
   r.give_route(RouteKind::kNoPath, {});
@@ -329,6 +441,79 @@ TEST(DeadEndRecovery, AnEscapeStuckTooOftenEndsInNoRoute) {
   r.in.engaged = false;
   EXPECT_EQ(r.step().phase, RecoveryPhase::kIdle);
   EXPECT_EQ(r.recovery.attempts(), 0);
+}
+
+// Looks that find no route climb by climb_step, up to the ceiling; there,
+// no route. Each climb done counts as progress (the looks count from none).
+TEST(DeadEndRecovery, NoRouteAfterTheLookClimbsToLookAgainUpToTheCeiling) {
+  RecoverySettings s = settings();
+  s.climb_step = 15.0;
+  s.climb_ceiling = 60.0;
+  RecoveryRun r(s);
+  r.run(4.1);
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  r.give_route(RouteKind::kNoPath, {});
+  RecoveryDecision d = r.run(3.1);
+  ASSERT_EQ(d.phase, RecoveryPhase::kClimbing) << r.last_reason;
+  EXPECT_NEAR(d.climb_altitude, 51.6, 1e-9);
+  EXPECT_NE(r.last_reason.find("climbing from 36.6 to 51.6 m"), std::string::npos) << r.last_reason;
+  // Under way (the planner still says no path, periodically): still climbing.
+  r.in.velocity = Vec3(0, 0, -1.2);
+  r.in.altitude = 45.0;
+  r.give_route(RouteKind::kNoPath, {});
+  EXPECT_EQ(r.run(5).phase, RecoveryPhase::kClimbing);
+  // There, at rest: a look from the new altitude, the first of a new count.
+  r.in.velocity = Vec3::Zero();
+  r.in.altitude = 51.3;
+  d = r.step();
+  ASSERT_EQ(d.phase, RecoveryPhase::kLooking) << r.last_reason;
+  EXPECT_EQ(r.recovery.attempts(), 1);
+  // No route from there either: the next climb stops at the ceiling.
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  r.give_route(RouteKind::kNoPath, {});
+  d = r.run(3.1);
+  ASSERT_EQ(d.phase, RecoveryPhase::kClimbing);
+  EXPECT_NEAR(d.climb_altitude, 60.0, 1e-9);
+  r.in.altitude = 59.8;
+  ASSERT_EQ(r.step().phase, RecoveryPhase::kLooking);
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  r.give_route(RouteKind::kNoPath, {});
+  d = r.run(3.1);
+  EXPECT_EQ(d.phase, RecoveryPhase::kNoRoute);
+  EXPECT_EQ(r.run(30).phase, RecoveryPhase::kNoRoute);
+}
+
+TEST(DeadEndRecovery, ARouteFoundOnTheWayUpIsTakenAtOnce) {
+  RecoveryRun r;
+  r.run(4.1);
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  r.give_route(RouteKind::kNoPath, {});
+  ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+  r.in.velocity = Vec3(0, 0, -1.2);
+  r.in.altitude = 42.0;
+  r.give_route(RouteKind::kForward, {r.in.position, Vec3(150, 0, -42.0)});
+  EXPECT_EQ(r.step().phase, RecoveryPhase::kTurning);
+}
+
+// A climb the commit gate refuses leaves the vehicle hovering where it was:
+// after the time a climb may take, a look; the looks then count on to "no
+// route", so refused climbs cannot go on for ever.
+TEST(DeadEndRecovery, AClimbThatDoesNotProceedEndsInNoRoute) {
+  RecoveryRun r;  // max_attempts 2
+  r.run(4.1);
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  r.give_route(RouteKind::kNoPath, {});
+  ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+  const double allowed = settings().climb_step / 1.5 + settings().climb_extra_time;
+  EXPECT_EQ(r.run(allowed - 0.5).phase, RecoveryPhase::kClimbing);
+  RecoveryDecision d = r.run(0.6);
+  ASSERT_EQ(d.phase, RecoveryPhase::kLooking);
+  EXPECT_NE(r.last_reason.find("the climb stopped at 36.6 m"), std::string::npos) << r.last_reason;
+  EXPECT_EQ(r.recovery.attempts(), 2);
+  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  r.give_route(RouteKind::kNoPath, {});
+  ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+  EXPECT_EQ(r.run(allowed + 0.1).phase, RecoveryPhase::kNoRoute);
 }
 
 TEST(DeadEndRecovery, DisabledItNeverActs) {

@@ -1,5 +1,6 @@
 #include "ofn/rh_optimizer/dead_end_recovery.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -15,6 +16,8 @@ const char* to_string(RecoveryPhase phase) {
       return "turning to the way on";
     case RecoveryPhase::kEscaping:
       return "escaping";
+    case RecoveryPhase::kClimbing:
+      return "climbing to look";
     case RecoveryPhase::kNoRoute:
       return "no route";
   }
@@ -157,6 +160,21 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
   return true;
 }
 
+void DeadEndRecovery::climb_or_hold(const RecoveryInput& in, const std::string& why) {
+  const double ceiling = settings_.climb_ceiling;
+  if (!(settings_.climb_step > 0) || !(in.altitude + settings_.climb_tolerance < ceiling)) {
+    enter(RecoveryPhase::kNoRoute, why + ": holding the hover");
+    return;
+  }
+  const double altitude = std::min(in.altitude + settings_.climb_step, ceiling);
+  std::ostringstream text;
+  text << why << ": climbing from " << in.altitude << " to " << altitude
+       << " m to look over what the scanner saw from below";
+  enter(RecoveryPhase::kClimbing, text.str());
+  decision_.climb_altitude = altitude;
+  climb_start_ = in.time;
+}
+
 RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
   decision_.changed = false;
   decision_.reason.clear();
@@ -201,8 +219,7 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       if (!look_end_) {
         if (turned_through(in)) look_end_ = in.time;
       } else if (in.time - *look_end_ >= settings_.route_wait && in.route_time >= *look_end_) {
-        if (!take_route(in))
-          enter(RecoveryPhase::kNoRoute, "no route after the look-around: holding the hover");
+        if (!take_route(in)) climb_or_hold(in, "no route after the look-around");
       } else if (in.time - *look_end_ >= settings_.route_timeout) {
         enter(RecoveryPhase::kNoRoute, "no new route after the look-around: holding the hover");
       }
@@ -235,6 +252,29 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       } else if (stuck(in) != Stuck::kNo)
         begin_look("the escape is stuck");
       break;
+    case RecoveryPhase::kClimbing: {
+      // A route the planner found on the way up is taken at once; else the
+      // climb ends at its altitude (or where the time allowed got it) with
+      // a look around. Only a climb done counts as progress: one the gate
+      // refused leaves the looks counting to "no route".
+      if (in.route_time > climb_start_ && take_route(in)) break;
+      const bool reached =
+          std::abs(in.altitude - decision_.climb_altitude) <= settings_.climb_tolerance &&
+          in.velocity.norm() < settings_.hover_speed;
+      const double allowed =
+          settings_.climb_step / std::max(in.max_vertical_speed, 1e-3) + settings_.climb_extra_time;
+      if (reached) {
+        attempts_ = 0;
+        std::ostringstream why;
+        why << "climbed to " << in.altitude << " m";
+        begin_look(why.str().c_str());
+      } else if (in.time - climb_start_ >= allowed) {
+        std::ostringstream why;
+        why << "the climb stopped at " << in.altitude << " m";
+        begin_look(why.str().c_str());
+      }
+      break;
+    }
     case RecoveryPhase::kNoRoute:
       // A route may appear later (an obstacle gone, a better map): taken up
       // while looks remain.

@@ -132,6 +132,7 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   b.stall_retry = f.boolean("stall_retry", b.stall_retry);
   b.short_retry = f.boolean("short_retry", b.short_retry);
   b.short_retry_fraction = f.number_in("short_retry_fraction", b.short_retry_fraction, 0.05, 0.95);
+  b.climb_fraction = f.number_in("climb_fraction", b.climb_fraction, 0.1, 1.0);
   f.finish();
 
   // The stop's deceleration is fallback.braking_accel_fraction and its
@@ -153,6 +154,10 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
     d.face_hold = v.number_in("face_hold", d.face_hold, 0.0, 30.0);
     d.max_attempts = static_cast<int>(v.integer("max_attempts", d.max_attempts));
     if (d.max_attempts < 1 || d.max_attempts > 100) v.fail("max_attempts", "expected 1..100");
+    d.climb_step = v.number_in("climb_step", d.climb_step, 0.0, 500.0);
+    d.climb_ceiling = v.number_in("climb_ceiling", d.climb_ceiling, 0.0, 1e4);
+    d.climb_tolerance = v.number_in("climb_tolerance", d.climb_tolerance, 0.05, 10.0);
+    d.climb_extra_time = v.number_in("climb_extra_time", d.climb_extra_time, 0.0, 600.0);
     v.finish();
   }
   YamlReader g = r.child("commit");
@@ -430,6 +435,8 @@ RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
   in.time = to_seconds(now);
   in.position = position;
   in.velocity = velocity;
+  in.altitude = -position.z() - config_.optimizer.ground_altitude;
+  in.max_vertical_speed = limits_from(mission_->limits).max_vertical_speed;
   in.yaw = nav_->euler[2];
   in.engaged = engaged;
   in.moving_plan = last_step_moving_;
@@ -649,7 +656,13 @@ void RhOptimizerService::tick() {
   if (config_.occlusion_depth > 0)
     in.seen = [this](double north, double east) { return visibility_.seen(north, east); };
 
-  const StepOutput out = planner_.step(in);
+  // A climb to look over what the scanner saw from below, straight up from
+  // the hover the look left; the controller turns the heading on the way,
+  // so the scanner looks all round at every altitude it passes.
+  const bool climbing = recovery.phase == RecoveryPhase::kClimbing;
+  const StepOutput out =
+      climbing ? planner_.climb(in, -(config_.optimizer.ground_altitude + recovery.climb_altitude))
+               : planner_.step(in);
   ++steps_;
   // A plan that moves off, not a stop, a stall or a hover in place: the
   // recovery counts the vehicle stuck without one.
@@ -673,8 +686,10 @@ void RhOptimizerService::tick() {
     }
   }
   const Utime t0 = to_utime(out.start_time);
-  node_.publish(channels::kRefTraj, trajectory_message(out.trajectory, t0, traj_mode(out.mode),
-                                                       config_.sample_period, now));
+  const int8_t mode =
+      climbing && out.mode == StepMode::kSolved ? ref_traj_t::LOOK_AROUND : traj_mode(out.mode);
+  node_.publish(channels::kRefTraj,
+                trajectory_message(out.trajectory, t0, mode, config_.sample_period, now));
   last_trajectory_ = out.trajectory;
   last_trajectory_t0_ = t0;
   std::string message = recovery_message(recovery.phase, to_string(out.mode));

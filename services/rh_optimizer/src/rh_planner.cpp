@@ -72,6 +72,89 @@ CommitCheck RhPlanner::gate_check(const BsplineTrajectory& plan, double elapsed,
 void RhPlanner::reset() {
   previous_ = BsplineTrajectory();
   previous_start_ = 0;
+  climb_ = BsplineTrajectory();
+  climb_start_ = 0;
+}
+
+BsplineTrajectory vertical_move(const Vec3& from, double to_z, double max_speed, double max_accel) {
+  const double rise = to_z - from.z();
+  if (!(std::abs(rise) > 1e-9) || !(max_speed > 0) || !(max_accel > 0) || !from.allFinite() ||
+      !std::isfinite(to_z))
+    return {};
+  const Vec3 to(from.x(), from.y(), to_z);
+  BsplineTrajectory best;
+  // Few intervals: a smooth step limited by the acceleration; many: a
+  // cruise at the speed limit between short ramps. The duration scales the
+  // peaks (speed as 1/T, acceleration as 1/T^2), so each shape is measured
+  // once at T = 1 and stretched to the tighter limit.
+  for (int intervals = 3; intervals <= 40; ++intervals) {
+    std::vector<double> knots(4, 0.0);
+    for (int i = 1; i < intervals; ++i) knots.push_back(static_cast<double>(i) / intervals);
+    knots.insert(knots.end(), 4, 1.0);
+    std::vector<Vec3> control_points;
+    const int count = intervals + 3;
+    for (int i = 0; i < count; ++i) {
+      const double f = std::clamp(static_cast<double>(i - 2) / (count - 5), 0.0, 1.0);
+      control_points.push_back(from + (to - from) * f);
+    }
+    const BsplineTrajectory unit(3, knots, control_points, 1.0);
+    double peak_speed = 0, peak_accel = 0;
+    constexpr int kSamples = 400;
+    for (int k = 0; k <= kSamples; ++k) {
+      const double t = static_cast<double>(k) / kSamples;
+      peak_speed = std::max(peak_speed, unit.velocity(t).norm());
+      peak_accel = std::max(peak_accel, unit.acceleration(t).norm());
+    }
+    const double duration =
+        std::max(peak_speed / max_speed, std::sqrt(peak_accel / max_accel)) * 1.0001;
+    if (best.empty() || duration < best.duration())
+      best = BsplineTrajectory(3, std::move(knots), std::move(control_points), duration);
+  }
+  return best;
+}
+
+StepOutput RhPlanner::climb(const StepInput& input, double target_z) {
+  StepOutput out;
+  const RhProblem& problem = input.problem;
+  auto brake = [&](const std::string& why) {
+    out.mode = StepMode::kBraking;
+    out.trajectory = braking_trajectory(problem);
+    out.start_time = std::isfinite(input.time) ? input.time : 0.0;
+    out.reason = why;
+    reset();
+    return out;
+  };
+  if (!problem.position.allFinite() || !problem.velocity.allFinite() ||
+      !problem.acceleration.allFinite() || !std::isfinite(input.time) || !std::isfinite(target_z))
+    return brake("non-finite state, time or climb altitude");
+  const bool same_climb =
+      !climb_.empty() && std::abs(climb_.position(climb_.duration()).z() - target_z) < 1e-6;
+  if (!same_climb) {
+    // From a hover only: the climb starts at rest, and the gate holds it to
+    // the state flown.
+    const double speed = problem.velocity.norm(), accel = problem.acceleration.norm();
+    if (!(speed <= fallback_.climb_start_speed && accel <= fallback_.climb_start_accel)) {
+      std::ostringstream why;
+      why << "not a hover yet (" << speed << " m/s): braking before the climb";
+      return brake(why.str());
+    }
+    climb_ = vertical_move(problem.position, target_z,
+                           fallback_.climb_fraction * problem.limits.max_vertical_speed,
+                           fallback_.climb_fraction * problem.limits.max_accel);
+    climb_start_ = input.time;
+    if (climb_.empty()) return brake("no climb: already at its altitude");
+  }
+  out.commit = gate_check(climb_, input.time - climb_start_, input);
+  if (!out.commit.committed) {
+    ++out.refused;
+    out.refusal = out.commit.reason;
+    return brake("the commit gate refused the climb: " + out.commit.reason);
+  }
+  out.mode = StepMode::kSolved;
+  out.trajectory = climb_;
+  out.start_time = climb_start_;
+  out.reason = "climbing";
+  return out;
 }
 
 namespace {

@@ -22,8 +22,17 @@
 //       which the rest of the route heads along the leg, then normal
 //       planning (left to itself, the forward-only optimiser would take the
 //       shorter way straight on, back into the dead end);
-//     - none: hold the hover and say so (no route), and take up a route if
-//       one appears later.
+//     - none: climb straight up by `climb_step`, then look around again,
+//       up to `climb_ceiling`. A top no beam went over counts as reaching
+//       the ceiling, and the scanner fans only +-42.5 deg about the
+//       horizontal: from below, a top far above it is out of the fan near
+//       the wall and out of range far from it. From higher up the way over
+//       may show;
+//     - none at the ceiling: hold the hover and say so (no route), and take
+//       up a route if one appears later.
+// A climb is safe in the mapped world: obstacles stand on the ground (the
+// grid is a height per cell), so the column above a hover clear of every
+// obstacle is clear all the way up.
 // Every plan flown in recovery passes the same commit gate as any other.
 // Pure core: world NED, SI, time in seconds of the caller's clock.
 
@@ -51,9 +60,16 @@ struct RecoverySettings {
       0.26;                // rad; an escape leg starts once the heading is this near its direction
   double face_hold = 1.0;  // s facing the leg before it starts (the scanner clears its shadows)
   int max_attempts = 3;  // looks in a row with no escape leg done between: then "no route" for good
+  double climb_step = 15.0;      // m climbed after a look that found no route (0: never climb)
+  double climb_ceiling = 120.0;  // m above the ground; no climb goes higher
+  double climb_tolerance = 0.5;  // m from the climb's altitude at which it is done
+  /// s a climb may take beyond climb_step at the vertical speed limit, after
+  /// which it ends where it got to (a climb the commit gate refuses stays a
+  /// hover).
+  double climb_extra_time = 15.0;
 };
 
-enum class RecoveryPhase { kIdle, kLooking, kTurning, kEscaping, kNoRoute };
+enum class RecoveryPhase { kIdle, kLooking, kTurning, kEscaping, kClimbing, kNoRoute };
 const char* to_string(RecoveryPhase phase);
 
 /// A step's SOLVER_STATS message in `phase`: during an escape it begins
@@ -72,9 +88,11 @@ struct RecoveryInput {
   double time = 0;  // s
   Vec3 position = Vec3::Zero();
   Vec3 velocity = Vec3::Zero();
-  double yaw = 0;            // rad, the vehicle's heading
-  bool engaged = false;      // avoidance engaged (false: guidance flies the leg)
-  bool moving_plan = false;  // the last step committed a solved plan that moves off
+  double altitude = 0;              // m above the ground
+  double max_vertical_speed = 1.0;  // m/s, the mission's limit (bounds a climb's time)
+  double yaw = 0;                   // rad, the vehicle's heading
+  bool engaged = false;             // avoidance engaged (false: guidance flies the leg)
+  bool moving_plan = false;         // the last step committed a solved plan that moves off
   RouteKind route = RouteKind::kNone;
   double route_time = -1e300;  // s, when that route was made
   // world NED, vehicle first: the route's points, whatever its kind
@@ -95,6 +113,8 @@ struct RecoveryDecision {
   // seen from above). A look turns to the right; a turn to face the way on
   // takes the shorter way (the one way round cost up to 12 s per escape leg).
   bool turn_left = false;
+  // While climbing: the altitude (m above the ground) to climb to.
+  double climb_altitude = 0;
 };
 
 /// Index of the first route point from which every further step heads
@@ -145,6 +165,9 @@ class DeadEndRecovery {
   /// Takes up the route of `in` if it leads anywhere: normal planning or
   /// an escape. Returns false when there is none.
   bool take_route(const RecoveryInput& in);
+  /// After a look that found no route: a climb if one is left below the
+  /// ceiling, else no route. `why` says what the look found.
+  void climb_or_hold(const RecoveryInput& in, const std::string& why);
 
   RecoverySettings settings_;
   RecoveryDecision decision_;
@@ -161,6 +184,7 @@ class DeadEndRecovery {
   double face_yaw_ = 0;                              // rad, where kTurning turns to
   RecoveryPhase after_turn_ = RecoveryPhase::kIdle;  // what follows kTurning
   int attempts_ = 0;
+  double climb_start_ = 0;  // s, when the climb began
 };
 
 }  // namespace ofn::rh

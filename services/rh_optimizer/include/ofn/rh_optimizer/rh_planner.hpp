@@ -23,6 +23,10 @@ struct FallbackSettings {
   bool stall_retry = true;  // a stalled warm plan: also solve from the path, fly the cheaper
   bool short_retry = true;  // before a stop (no plan, none to keep): once more to a nearer x
   double short_retry_fraction = 0.5;  // of the way from the vehicle to the terminal x
+  double climb_fraction = 0.8;  // of the vertical speed and acceleration limits a climb flies at
+  // A climb starts only from a hover this still (the commit gate's start tolerances).
+  double climb_start_speed = 0.05;  // m/s
+  double climb_start_accel = 0.05;  // m/s^2
 };
 
 /// A stall: the vehicle is slow (below kStallSpeedFraction of the speed
@@ -72,13 +76,28 @@ struct StepOutput {
   std::string refusal;           // why it refused the last of them (another may be flown)
 };
 
+/// A climb straight up (or down) from a hover at `from` to a hover at world
+/// z `to_z`: a clamped uniform cubic B-spline whose first and last three
+/// control points coincide (zero velocity and acceleration at both ends)
+/// with the rest evenly spaced between, the number of knot intervals chosen
+/// for the shortest duration within `max_speed` and `max_accel` (m/s,
+/// m/s^2, both > 0). Empty when the two altitudes are the same.
+BsplineTrajectory vertical_move(const Vec3& from, double to_z, double max_speed, double max_accel);
+
 class RhPlanner {
  public:
   explicit RhPlanner(RhSettings settings = {}, FallbackSettings fallback = {},
                      CommitSettings commit = {});
 
   StepOutput step(const StepInput& input);
-  /// Forgets the previous solution (after avoidance hands back).
+  /// One step of a climb straight up to world z `target_z` (dead-end
+  /// recovery): planned once, from a hover, by vertical_move at
+  /// climb_fraction of the vertical speed and acceleration limits, then
+  /// flown while the commit gate accepts it from each step's instant on.
+  /// Brakes from a state that is not a hover and when the gate refuses.
+  StepOutput climb(const StepInput& input, double target_z);
+  /// Forgets the previous solution and any climb (after avoidance hands
+  /// back, or a new recovery phase).
   void reset();
   bool has_previous() const { return !previous_.empty(); }
 
@@ -105,6 +124,8 @@ class RhPlanner {
   // flown, so a fallback never returns to a plan the vehicle has left.
   BsplineTrajectory previous_;
   double previous_start_ = 0;
+  BsplineTrajectory climb_;  // the climb flown (empty: none)
+  double climb_start_ = 0;   // s, clock time of its t = 0
 };
 
 }  // namespace ofn::rh
