@@ -267,6 +267,9 @@ TEST(RecoveryMessage, MarksEveryStepOfAnEscapeOnce) {
   EXPECT_EQ(recovery_message(RecoveryPhase::kEscaping, "map starved of scans: 17 %"),
             "escaping: map starved of scans: 17 %");
   EXPECT_EQ(recovery_message(RecoveryPhase::kEscaping, "escaping: braking"), "escaping: braking");
+  EXPECT_EQ(recovery_message(RecoveryPhase::kClimbing, "solved: climbing"),
+            "climbing: solved: climbing");
+  EXPECT_EQ(recovery_message(RecoveryPhase::kClimbing, "climbing: braking"), "climbing: braking");
   for (RecoveryPhase other : {RecoveryPhase::kIdle, RecoveryPhase::kLooking,
                               RecoveryPhase::kTurning, RecoveryPhase::kNoRoute})
     EXPECT_EQ(recovery_message(other, "nav stale"), "nav stale") << to_string(other);

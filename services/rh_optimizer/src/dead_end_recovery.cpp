@@ -25,9 +25,11 @@ const char* to_string(RecoveryPhase phase) {
 }
 
 std::string recovery_message(RecoveryPhase phase, const std::string& message) {
-  constexpr const char* kMark = "escaping: ";
-  if (phase != RecoveryPhase::kEscaping || message.rfind(kMark, 0) == 0) return message;
-  return kMark + message;
+  const char* mark = phase == RecoveryPhase::kEscaping   ? "escaping: "
+                     : phase == RecoveryPhase::kClimbing ? "climbing: "
+                                                         : nullptr;
+  if (!mark || message.rfind(mark, 0) == 0) return message;
+  return mark + message;
 }
 
 std::optional<size_t> escape_leg_end(const std::vector<Vec3>& route, const GuidanceFrame& leg,

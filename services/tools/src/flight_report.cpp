@@ -317,9 +317,9 @@ class LogDecoder {
       record_.plan_steps.push_back({t, rel(m.map_utime)});
     // The dead-end recovery's steps, joined into spans (the optimiser
     // reports at 5-20 Hz; a gap of a second ends a span).
-    const bool recovering = m.status == solver_stats_t::LOOKING_AROUND ||
-                            m.status == solver_stats_t::NO_ROUTE ||
-                            m.message.rfind("escaping", 0) == 0;
+    const bool recovering =
+        m.status == solver_stats_t::LOOKING_AROUND || m.status == solver_stats_t::NO_ROUTE ||
+        m.message.rfind("escaping", 0) == 0 || m.message.rfind("climbing", 0) == 0;
     if (recovering) {
       auto& spans = record_.recovery;
       if (!spans.empty() && t - spans.back().end <= 1.0)

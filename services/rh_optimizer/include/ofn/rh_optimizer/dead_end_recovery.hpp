@@ -73,10 +73,12 @@ enum class RecoveryPhase { kIdle, kLooking, kTurning, kEscaping, kClimbing, kNoR
 const char* to_string(RecoveryPhase phase);
 
 /// A step's SOLVER_STATS message in `phase`: during an escape it begins
-/// "escaping: " whatever the step did (solved, kept, braked, or did not run
-/// at all for a blind map). The verdict relaxes the forward-speed rule by
-/// this mark, and the controller flies the escape plan or its stop while
-/// the optimiser is blind, so a blind step must not end the escape's span.
+/// "escaping: ", during a climb "climbing: ", whatever the step did
+/// (solved, kept, braked, or did not run at all for a blind map). The
+/// verdict relaxes the forward-speed rule by this mark and the report
+/// counts the time in recovery by it, and the controller flies the escape
+/// plan or its stop while the optimiser is blind, so a blind step must not
+/// end the span.
 std::string recovery_message(RecoveryPhase phase, const std::string& message);
 
 /// What the global planner last said, as the optimiser received it: a
