@@ -113,17 +113,21 @@ BsplineTrajectory vertical_move(const Vec3& from, double to_z, double max_speed,
   return best;
 }
 
+StepOutput RhPlanner::brake(const StepInput& input, StepOutput out, const std::string& why) {
+  // The stop from the state flown now; the plan it leaves is forgotten,
+  // so no later fallback returns to where the vehicle no longer is.
+  out.mode = StepMode::kBraking;
+  out.trajectory = braking_trajectory(input.problem);
+  out.start_time = std::isfinite(input.time) ? input.time : 0.0;
+  out.reason = why;
+  reset();
+  return out;
+}
+
 StepOutput RhPlanner::climb(const StepInput& input, double target_z) {
   StepOutput out;
   const RhProblem& problem = input.problem;
-  auto brake = [&](const std::string& why) {
-    out.mode = StepMode::kBraking;
-    out.trajectory = braking_trajectory(problem);
-    out.start_time = std::isfinite(input.time) ? input.time : 0.0;
-    out.reason = why;
-    reset();
-    return out;
-  };
+  auto brake = [&](const std::string& why) { return this->brake(input, out, why); };
   if (!problem.position.allFinite() || !problem.velocity.allFinite() ||
       !problem.acceleration.allFinite() || !std::isfinite(input.time) || !std::isfinite(target_z))
     return brake("non-finite state, time or climb altitude");
@@ -272,16 +276,7 @@ std::optional<Conflict> first_conflict(const BsplineTrajectory& plan, double fro
 StepOutput RhPlanner::step(const StepInput& input) {
   StepOutput out;
   const RhProblem& problem = input.problem;
-  auto brake = [&](const std::string& why) {
-    // The stop from the state flown now; the plan it leaves is forgotten,
-    // so no later fallback returns to where the vehicle no longer is.
-    out.mode = StepMode::kBraking;
-    out.trajectory = braking_trajectory(problem);
-    out.start_time = std::isfinite(input.time) ? input.time : 0.0;
-    out.reason = why;
-    reset();
-    return out;
-  };
+  auto brake = [&](const std::string& why) { return this->brake(input, out, why); };
 
   const bool state_finite = problem.position.allFinite() && problem.velocity.allFinite() &&
                             problem.acceleration.allFinite() && std::isfinite(input.time);

@@ -114,6 +114,9 @@ class RhPlanner {
 
  private:
   double braking_decel(const RhProblem& problem) const;
+  /// `out` (what the step has found so far: solves, refusals, report) as a
+  /// stop from the state flown, and the plan left forgotten.
+  StepOutput brake(const StepInput& input, StepOutput out, const std::string& why);
   CommitCheck gate_check(const BsplineTrajectory& plan, double elapsed,
                          const StepInput& input) const;
 
