@@ -17,6 +17,7 @@
 #include "ofn/control_status_t.hpp"
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/nav_state_t.hpp"
+#include "ofn/solver_stats_t.hpp"
 #include "ofn/tools/flight_report.hpp"
 
 namespace ofn::report {
@@ -138,6 +139,38 @@ TEST_F(FlightReport, AHoverIsTabledAndSummarised) {
   EXPECT_NEAR(json.at("min_clearance").get<double>(), *result.min_clearance, 1e-12);
   EXPECT_EQ(json.at("failures").size(), result.verdict.failures.size());
   EXPECT_EQ(json.at("obstacles").size(), open.obstacles.size());
+}
+
+// The time in dead-end recovery counts the steps the optimiser marks as
+// such: looks (LOOKING_AROUND), escapes ("escaping: ...") and climbs to
+// look ("climbing: ..."), each a span of steps with no gap over 1 s;
+// ordinary solved steps do not count.
+TEST_F(FlightReport, RecoveryTimeCountsLooksEscapesAndClimbs) {
+  const Scenario open = load_scenario(kOpenScenario);
+  const std::string path = hover_log("recovery.lcm", open.start_position, 20.0);
+  {
+    lcm::LogFile log(path, "a");
+    ASSERT_TRUE(log.good());
+    const Utime t0 = 1000 * kMicrosPerSecond;
+    auto steps = [&](double from, double to, int8_t status, const std::string& message) {
+      for (double t = from; t <= to + 1e-9; t += 0.1) {
+        solver_stats_t m{};
+        m.utime = t0 + static_cast<Utime>(t * kMicrosPerSecond);
+        m.status = status;
+        m.message = message;
+        write(log, channels::kSolverStats, m, m.utime);
+      }
+    };
+    steps(1.0, 2.0, solver_stats_t::SOLVED, "solved");
+    steps(3.0, 5.0, solver_stats_t::LOOKING_AROUND, "recovery: looking around");
+    steps(5.1, 8.0, solver_stats_t::SOLVED, "climbing: solved: climbing");
+    steps(10.0, 12.0, solver_stats_t::BRAKING, "escaping: braking");
+    steps(14.0, 15.0, solver_stats_t::SOLVED, "solved");
+  }
+  const ReportResult result =
+      write_flight_report(path, (dir_ / "report").string(), open, PseudoControlBound{});
+  // 3.0-8.0 (a look, then a climb) and 10.0-12.0 (an escape).
+  EXPECT_NEAR(result.summary.recovery_time, 7.0, 1e-3);
 }
 
 // A scenario named with quotes, backslashes and a line break, a log path
