@@ -486,6 +486,30 @@ TEST(DeadEndRecovery, NoRouteAfterTheLookClimbsToLookAgainUpToTheCeiling) {
   EXPECT_EQ(r.run(30).phase, RecoveryPhase::kNoRoute);
 }
 
+// The climb turns the heading (LOOK_AROUND): one that turned all round on
+// the way up has seen what a look at its altitude would show, and only the
+// route is waited for; one that did not turn needs the look.
+TEST(DeadEndRecovery, AClimbThatTurnedAllRoundNeedsNoLookAfterIt) {
+  for (const bool turning : {true, false}) {
+    RecoveryRun r;
+    r.run(4.1);
+    r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+    r.give_route(RouteKind::kNoPath, {});
+    ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+    r.in.velocity = Vec3(0, 0, -1.2);
+    r.run(2 * M_PI / 0.5 + 0.3, turning ? 0.5 : 0.0);
+    ASSERT_EQ(r.recovery.phase(), RecoveryPhase::kClimbing);
+    r.in.velocity = Vec3::Zero();
+    r.in.altitude = 51.5;
+    ASSERT_EQ(r.step().phase, RecoveryPhase::kLooking);
+    EXPECT_EQ(r.last_reason.find("the look is done") != std::string::npos, turning)
+        << r.last_reason;
+    r.give_route(RouteKind::kForward, {r.in.position, Vec3(150, 0, -51.5)});
+    EXPECT_EQ(r.run(3.1).phase, turning ? RecoveryPhase::kTurning : RecoveryPhase::kLooking)
+        << "turning on the way up: " << turning;
+  }
+}
+
 TEST(DeadEndRecovery, ARouteFoundOnTheWayUpIsTakenAtOnce) {
   RecoveryRun r;
   r.run(4.1);

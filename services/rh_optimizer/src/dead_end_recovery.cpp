@@ -172,6 +172,7 @@ void DeadEndRecovery::climb_or_hold(const RecoveryInput& in, const std::string& 
   std::ostringstream text;
   text << why << ": climbing from " << in.altitude << " to " << altitude
        << " m to look over what the scanner saw from below";
+  begin_turn(in);  // the heading turns on the way up: counted from here
   enter(RecoveryPhase::kClimbing, text.str());
   decision_.climb_altitude = altitude;
   climb_start_ = in.time;
@@ -260,6 +261,8 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       // a look around. Only a climb done counts as progress: one the gate
       // refused leaves the looks counting to "no route".
       if (in.route_time > climb_start_ && take_route(in)) break;
+      turned_through(in);
+      const bool turned_all_round = std::abs(turned_) >= settings_.look_turn;
       const bool reached =
           std::abs(in.altitude - decision_.climb_altitude) <= settings_.climb_tolerance &&
           in.velocity.norm() < settings_.hover_speed;
@@ -269,7 +272,12 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
         attempts_ = 0;
         std::ostringstream why;
         why << "climbed to " << in.altitude << " m";
+        if (turned_all_round) why << " (the heading turned all round on the way: the look is done)";
         begin_look(why.str().c_str());
+        // The scanner has seen all round at every altitude of the climb:
+        // another turn here would show nothing new, only the route is
+        // waited for.
+        if (turned_all_round) look_end_ = in.time;
       } else if (in.time - climb_start_ >= allowed) {
         std::ostringstream why;
         why << "the climb stopped at " << in.altitude << " m";

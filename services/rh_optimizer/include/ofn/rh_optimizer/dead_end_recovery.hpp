@@ -22,8 +22,9 @@
 //       which the rest of the route heads along the leg, then normal
 //       planning (left to itself, the forward-only optimiser would take the
 //       shorter way straight on, back into the dead end);
-//     - none: climb straight up by `climb_step`, then look around again,
-//       up to `climb_ceiling`. A top no beam went over counts as reaching
+//     - none: climb straight up by `climb_step`, turning the heading on
+//       the way (a climb that turned all round needs no look after it),
+//       then look around again, up to `climb_ceiling`. A top no beam went over counts as reaching
 //       the ceiling, and the scanner fans only +-42.5 deg about the
 //       horizontal: from below, a top far above it is out of the fan near
 //       the wall and out of range far from it. From higher up the way over
