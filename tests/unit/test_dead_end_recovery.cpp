@@ -238,6 +238,13 @@ class RecoveryRun {
     in.route_time = in.time;
     route = std::move(points);
   }
+  /// A look from start to end: a full turn at 0.5 rad/s, then the planner's
+  /// route made after it, then the recovery's wait for it.
+  RecoveryDecision look_finds(RouteKind kind, std::vector<Vec3> points = {}) {
+    run(2 * M_PI / 0.5 + 0.3, 0.5);
+    give_route(kind, std::move(points));
+    return run(3.1);
+  }
 
   DeadEndRecovery recovery;
   RecoveryInput in;
@@ -410,9 +417,7 @@ TEST(DeadEndRecovery, NoRouteAfterTheLookHoldsTheHoverAndSaysSo) {
   never_climbs.climb_step = 0.0;
   RecoveryRun r(never_climbs);
   r.run(4.1);
-  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-  r.give_route(RouteKind::kNoPath, {});
-  RecoveryDecision d = r.run(3.1);
+  RecoveryDecision d = r.look_finds(RouteKind::kNoPath);
   EXPECT_EQ(d.phase, RecoveryPhase::kNoRoute);
   EXPECT_EQ(r.run(30).phase, RecoveryPhase::kNoRoute);
   // No route heard at all after the look: no route too, at the timeout.
@@ -454,9 +459,7 @@ TEST(DeadEndRecovery, NoRouteAfterTheLookClimbsToLookAgainUpToTheCeiling) {
   s.climb_ceiling = 60.0;
   RecoveryRun r(s);
   r.run(4.1);
-  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-  r.give_route(RouteKind::kNoPath, {});
-  RecoveryDecision d = r.run(3.1);
+  RecoveryDecision d = r.look_finds(RouteKind::kNoPath);
   ASSERT_EQ(d.phase, RecoveryPhase::kClimbing) << r.last_reason;
   EXPECT_NEAR(d.climb_altitude, 51.6, 1e-9);
   EXPECT_NE(r.last_reason.find("climbing from 36.6 to 51.6 m"), std::string::npos) << r.last_reason;
@@ -472,16 +475,12 @@ TEST(DeadEndRecovery, NoRouteAfterTheLookClimbsToLookAgainUpToTheCeiling) {
   ASSERT_EQ(d.phase, RecoveryPhase::kLooking) << r.last_reason;
   EXPECT_EQ(r.recovery.attempts(), 1);
   // No route from there either: the next climb stops at the ceiling.
-  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-  r.give_route(RouteKind::kNoPath, {});
-  d = r.run(3.1);
+  d = r.look_finds(RouteKind::kNoPath);
   ASSERT_EQ(d.phase, RecoveryPhase::kClimbing);
   EXPECT_NEAR(d.climb_altitude, 60.0, 1e-9);
   r.in.altitude = 59.8;
   ASSERT_EQ(r.step().phase, RecoveryPhase::kLooking);
-  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-  r.give_route(RouteKind::kNoPath, {});
-  d = r.run(3.1);
+  d = r.look_finds(RouteKind::kNoPath);
   EXPECT_EQ(d.phase, RecoveryPhase::kNoRoute);
   EXPECT_EQ(r.run(30).phase, RecoveryPhase::kNoRoute);
 }
@@ -493,9 +492,7 @@ TEST(DeadEndRecovery, AClimbThatTurnedAllRoundNeedsNoLookAfterIt) {
   for (const bool turning : {true, false}) {
     RecoveryRun r;
     r.run(4.1);
-    r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-    r.give_route(RouteKind::kNoPath, {});
-    ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+    ASSERT_EQ(r.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kClimbing);
     r.in.velocity = Vec3(0, 0, -1.2);
     r.run(2 * M_PI / 0.5 + 0.3, turning ? 0.5 : 0.0);
     ASSERT_EQ(r.recovery.phase(), RecoveryPhase::kClimbing);
@@ -513,9 +510,7 @@ TEST(DeadEndRecovery, AClimbThatTurnedAllRoundNeedsNoLookAfterIt) {
 TEST(DeadEndRecovery, ARouteFoundOnTheWayUpIsTakenAtOnce) {
   RecoveryRun r;
   r.run(4.1);
-  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-  r.give_route(RouteKind::kNoPath, {});
-  ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+  ASSERT_EQ(r.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kClimbing);
   r.in.velocity = Vec3(0, 0, -1.2);
   r.in.altitude = 42.0;
   r.give_route(RouteKind::kForward, {r.in.position, Vec3(150, 0, -42.0)});
@@ -528,18 +523,14 @@ TEST(DeadEndRecovery, ARouteFoundOnTheWayUpIsTakenAtOnce) {
 TEST(DeadEndRecovery, AClimbThatDoesNotProceedEndsInNoRoute) {
   RecoveryRun r;  // max_attempts 2
   r.run(4.1);
-  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-  r.give_route(RouteKind::kNoPath, {});
-  ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+  ASSERT_EQ(r.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kClimbing);
   const double allowed = settings().climb_step / 1.5 + settings().climb_extra_time;
   EXPECT_EQ(r.run(allowed - 0.5).phase, RecoveryPhase::kClimbing);
   RecoveryDecision d = r.run(0.6);
   ASSERT_EQ(d.phase, RecoveryPhase::kLooking);
   EXPECT_NE(r.last_reason.find("the climb stopped at 36.6 m"), std::string::npos) << r.last_reason;
   EXPECT_EQ(r.recovery.attempts(), 2);
-  r.run(2 * M_PI / 0.5 + 0.3, 0.5);
-  r.give_route(RouteKind::kNoPath, {});
-  ASSERT_EQ(r.run(3.1).phase, RecoveryPhase::kClimbing);
+  ASSERT_EQ(r.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kClimbing);
   EXPECT_EQ(r.run(allowed + 0.1).phase, RecoveryPhase::kNoRoute);
 }
 
