@@ -429,14 +429,14 @@ void RhOptimizerService::restart_planning() {
 }
 
 RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
-                                                     const Vec3& position, const Vec3& velocity,
-                                                     bool engaged) {
+                                                     const Limits& limits, const Vec3& position,
+                                                     const Vec3& velocity, bool engaged) {
   RecoveryInput in;
   in.time = to_seconds(now);
   in.position = position;
   in.velocity = velocity;
   in.altitude = -position.z() - config_.optimizer.ground_altitude;
-  in.max_vertical_speed = limits_from(mission_->limits).max_vertical_speed;
+  in.max_vertical_speed = limits.max_vertical_speed;
   in.yaw = nav_->euler[2];
   in.engaged = engaged;
   in.moving_plan = last_step_moving_;
@@ -539,7 +539,7 @@ void RhOptimizerService::tick() {
   const double stopping_speed = stopping_at_target_ ? velocity.norm() : 0.0;
   const bool engaged =
       switch_.update(t, conflict, cross_track_distance(leg, position), stopping_speed);
-  const RecoveryDecision recovery = update_recovery(now, leg, position, velocity, engaged);
+  const RecoveryDecision recovery = update_recovery(now, leg, limits, position, velocity, engaged);
   if (!engaged) {
     if (was_engaged) {
       hand_back(now, position, velocity, "nominal path clear, back on the leg");

@@ -124,8 +124,8 @@ class RhOptimizerService {
   void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
   void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
   /// Feeds the dead-end recovery; logs and acts on a change of its phase.
-  RecoveryDecision update_recovery(Utime now, const Leg& leg, const Vec3& position,
-                                   const Vec3& velocity, bool engaged);
+  RecoveryDecision update_recovery(Utime now, const Leg& leg, const Limits& limits,
+                                   const Vec3& position, const Vec3& velocity, bool engaged);
   /// Forgets the planner's previous plan, the last published one and the
   /// engagement's stop and stall flags (a new mission, a hand-back).
   void restart_planning();
