@@ -82,6 +82,37 @@ bool segment_meets(const Aabb& box, const Vec3& p, const Vec3& q) {
   return true;
 }
 
+// Horizontal distance from the zone's axis to the part of p -> q within
+// its height; infinity when no part is.
+double zone_approach(const NoGoZone& zone, const Vec3& p, const Vec3& q) {
+  const double lo = zone.centre.z() - zone.half_height;
+  const double hi = zone.centre.z() + zone.half_height;
+  double t0 = 0.0, t1 = 1.0;
+  const double dz = q.z() - p.z();
+  if (std::abs(dz) < 1e-12) {
+    if (p.z() < lo || p.z() > hi) return kInf;
+  } else {
+    double ta = (lo - p.z()) / dz;
+    double tb = (hi - p.z()) / dz;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return kInf;
+  }
+  const Eigen::Vector2d c = zone.centre.head<2>();
+  const Eigen::Vector2d a = p.head<2>() + t0 * (q - p).head<2>();
+  const Eigen::Vector2d b = p.head<2>() + t1 * (q - p).head<2>();
+  const Eigen::Vector2d ab = b - a;
+  double t = 0.0;
+  if (ab.squaredNorm() > 1e-12) t = std::clamp((c - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (a + t * ab - c).norm();
+}
+
+bool valid_zone(const NoGoZone& zone) {
+  return zone.centre.allFinite() && std::isfinite(zone.radius) && std::isfinite(zone.half_height) &&
+         zone.radius > 0 && zone.half_height > 0;
+}
+
 bool valid_box(const ObstacleBox& box) {
   return box.min_corner.allFinite() && box.max_corner.allFinite() &&
          (box.min_corner.array() < box.max_corner.array()).all();
@@ -195,6 +226,10 @@ class Problem {
     find_holders();
     relief_start_ = reliefs(start_);
     relief_goal_ = reliefs(goal_);
+    for (const NoGoZone& zone : request.no_go)
+      if (valid_zone(zone)) zones_.push_back(zone);
+    zone_relief_start_ = zone_reliefs(start_);
+    zone_relief_goal_ = zone_reliefs(goal_);
     place_nodes();
   }
 
@@ -250,6 +285,12 @@ class Problem {
         hit = segment_meets(solid_[b], p, q);
       }
     });
+    for (size_t z = 0; z < zones_.size() && !hit; ++z) {
+      double radius = zones_[z].radius;
+      if (from_start) radius = std::min(radius, zone_relief_start_[z]);
+      if (to_goal) radius = std::min(radius, zone_relief_goal_[z]);
+      hit = zone_approach(zones_[z], p, q) < radius;
+    }
     return hit;
   }
 
@@ -308,6 +349,18 @@ class Problem {
     for (size_t b = 0; b < boxes_.size(); ++b)
       if (strictly_inside(solid_[b], p))
         out[b] = outside_distance(raw_[b], p) - config_.collision_tolerance;
+    return out;
+  }
+
+  // As reliefs(), for the no-go zones: a point inside one sees it shrunk
+  // to the point's horizontal distance from its axis, less the tolerance.
+  std::vector<double> zone_reliefs(const Vec3& p) const {
+    std::vector<double> out(zones_.size(), kInf);
+    for (size_t z = 0; z < zones_.size(); ++z) {
+      const double distance = zone_approach(zones_[z], p, p);
+      if (distance < zones_[z].radius)
+        out[z] = std::max(0.0, distance - config_.collision_tolerance);
+    }
     return out;
   }
 
@@ -454,6 +507,8 @@ class Problem {
   std::vector<Aabb> raw_, clear_, solid_;
   BoxGrid grid_;
   std::vector<double> relief_start_, relief_goal_;
+  std::vector<NoGoZone> zones_;
+  std::vector<double> zone_relief_start_, zone_relief_goal_;
   int start_holder_ = -1, goal_holder_ = -1;
   std::vector<Vec3> nodes_, guidance_;
   std::vector<double> along_;

@@ -48,6 +48,16 @@ struct GlobalPlannerConfig {
   int max_obstacles = 500;            // more are ignored, nearest first kept
 };
 
+/// A region no segment may pass through, a vertical cylinder: a passage
+/// the RH optimiser found it cannot fly (narrower in the mapped cells than
+/// twice its clearance), although the cuboids leave it open. A start or
+/// goal inside it sees it shrunk to its own distance, so it can leave.
+struct NoGoZone {
+  Vec3 centre = Vec3::Zero();  // m, world NED
+  double radius = 0;           // m, horizontal
+  double half_height = 0;      // m above and below the centre
+};
+
 enum class PlanStatus { kOk, kStartInside, kGoalInside, kNoPath };
 
 const char* to_string(PlanStatus status);
@@ -58,6 +68,7 @@ struct PlanRequest {
   Vec3 goal = Vec3::Zero();            // m, world NED: the target waypoint
   Vec3 leg_from = Vec3::Zero();  // m: previous waypoint; the guidance x axis is leg_from -> goal
   std::vector<ObstacleBox> obstacles;
+  std::vector<NoGoZone> no_go;  // non-finite or non-positive ones are ignored
 };
 
 /// The graph of steps 1-6, for inspection and for checking the search.
