@@ -1,0 +1,115 @@
+// Pinches on a global route: gaps the RH optimiser cannot fly through with
+// its clearance (R_s plus its margin from the mapped cells), found by
+// climbing the clearance across the route, and the memory of them that
+// goes to the global planner.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "ofn/rh_optimizer/narrow_passage.hpp"
+#include "rh_step_inputs.hpp"
+
+namespace ofn::rh {
+namespace {
+
+using testing_support::Box;
+using testing_support::field_with;
+using testing_support::kBenchmarkLimits;
+using testing_support::kLegAltitude;
+
+// The optimiser's clearance on the benchmarks: R_s plus its 0.5 m margin.
+const double kRequired = kBenchmarkLimits.clearance + 0.5;
+
+// A route north along east = `east` at the leg altitude, a point every 2 m.
+std::vector<Vec3> route_north(double from, double to, double east) {
+  std::vector<Vec3> route;
+  for (double n = from; n <= to + 1e-9; n += 2.0) route.emplace_back(n, east, -kLegAltitude);
+  return route;
+}
+
+// Two tall blocks north 50..70 either side of east = 0, `gap` m apart.
+ClearanceQuery gap_of(int gap) {
+  const int half = gap / 2;
+  return field_with({Box{50, 70, -40, -half, 60.0f}, Box{50, 70, half, 40, 60.0f}});
+}
+
+TEST(NarrowPassage, AGapNarrowerThanTwiceTheClearanceIsAPinch) {
+  const ClearanceQuery clearance = gap_of(12);
+  const auto pinch = find_narrow_passage(clearance, route_north(0, 120, 0.0), kRequired);
+  ASSERT_TRUE(pinch.has_value());
+  // In the gap, at its widest (the middle), with less than the clearance.
+  EXPECT_GE(pinch->centre.x(), 48.0);
+  EXPECT_LE(pinch->centre.x(), 72.0);
+  EXPECT_LT(std::abs(pinch->centre.y()), 1.0);
+  EXPECT_LT(pinch->clearance, kRequired);
+  EXPECT_GT(pinch->clearance, 4.0);
+  // Any way through the gap passes within the radius of the centre.
+  EXPECT_GE(pinch->radius, 6.0);
+  EXPECT_LT(pinch->radius, kRequired + 1.0);
+  EXPECT_DOUBLE_EQ(pinch->half_height, PassageSettings{}.max_shift);
+}
+
+TEST(NarrowPassage, AWideEnoughGapIsNoPinchWhereverTheRouteCrossesIt) {
+  // 18 m: 9 m of room from the middle. A route 3 m off the middle is 6 m
+  // from a block, short of the clearance, but a trajectory beside it is not.
+  const ClearanceQuery clearance = gap_of(18);
+  EXPECT_FALSE(find_narrow_passage(clearance, route_north(0, 120, 0.0), kRequired));
+  EXPECT_FALSE(find_narrow_passage(clearance, route_north(0, 120, 3.0), kRequired));
+}
+
+TEST(NarrowPassage, ARouteAlongAWallAtTheCuboidClearanceIsNoPinch) {
+  // The global planner's nodes sit R_s from a cuboid: within the
+  // optimiser's margin, which it keeps by passing a little farther out.
+  const ClearanceQuery clearance = field_with({Box{50, 70, 6, 40, 60.0f}});
+  const auto route = route_north(0, 120, 0.0);
+  EXPECT_LT(clearance(Vec3(60, 0, -kLegAltitude)).distance, kRequired);
+  EXPECT_FALSE(find_narrow_passage(clearance, route, kRequired));
+}
+
+TEST(NarrowPassage, OnlyTheRoutesFirstLookDistanceIsChecked) {
+  const ClearanceQuery clearance = gap_of(12);
+  PassageSettings near;
+  near.look_distance = 30.0;  // the gap begins 50 m on
+  EXPECT_FALSE(find_narrow_passage(clearance, route_north(0, 120, 0.0), kRequired, near));
+  near.enabled = false;
+  near.look_distance = 200.0;
+  EXPECT_FALSE(find_narrow_passage(clearance, route_north(0, 120, 0.0), kRequired, near));
+}
+
+TEST(NarrowPassage, APinchRoundTheRoutesStartIsPassedOver) {
+  // The vehicle stopped in the middle of the gap: the planner lets routes
+  // leave a zone round their start, so such a zone would change nothing.
+  // What is reported is the gap farther on, clear of the start: the route
+  // then backs out.
+  const ClearanceQuery clearance = gap_of(12);
+  const auto route = route_north(60, 170, 0.0);
+  const auto pinch = find_narrow_passage(clearance, route, kRequired);
+  ASSERT_TRUE(pinch.has_value());
+  EXPECT_GT((pinch->centre - route.front()).head<2>().norm(), pinch->radius);
+  EXPECT_LE(pinch->centre.x(), 72.0);
+}
+
+TEST(NarrowPassage, NoQueryOrTooShortARouteFindsNothing) {
+  EXPECT_FALSE(find_narrow_passage(ClearanceQuery(), route_north(0, 120, 0.0), kRequired));
+  EXPECT_FALSE(find_narrow_passage(gap_of(12), {Vec3(60, 0, -kLegAltitude)}, kRequired));
+}
+
+TEST(PassageMemory, KeepsEachPassageOnceAndTheNewestWithinItsCapacity) {
+  PassageMemory memory(2);
+  const NarrowPassage a{Vec3(60, 0, -30), 6.0, 3.0, 5.5};
+  EXPECT_TRUE(memory.add(a));
+  // The same gap found again from a route a little to the side.
+  EXPECT_FALSE(memory.add(NarrowPassage{Vec3(61, 2, -31), 6.0, 3.0, 5.4}));
+  // The same spot 10 m higher is another passage.
+  EXPECT_TRUE(memory.add(NarrowPassage{Vec3(60, 0, -40), 6.0, 3.0, 5.0}));
+  EXPECT_TRUE(memory.add(NarrowPassage{Vec3(120, 0, -30), 6.0, 3.0, 5.0}));
+  ASSERT_EQ(memory.passages().size(), 2u);
+  EXPECT_EQ(memory.passages().front().centre, Vec3(60, 0, -40));
+  memory.clear();
+  EXPECT_TRUE(memory.passages().empty());
+}
+
+}  // namespace
+}  // namespace ofn::rh
