@@ -20,6 +20,7 @@
 #include "ofn/common/node.hpp"
 #include "ofn/cuboid_list_t.hpp"
 #include "ofn/global_path_t.hpp"
+#include "ofn/narrow_passages_t.hpp"
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
 #include "ofn/scan_world_t.hpp"
@@ -46,12 +47,12 @@ const std::vector<ServiceSpec>& service_specs() {
        {channels::kScanWorld, channels::kNavState},
        {channels::kObstacleGrid, channels::kCuboids}},
       {"global_planner",
-       {channels::kNavState, channels::kMission, channels::kCuboids},
+       {channels::kNavState, channels::kMission, channels::kCuboids, channels::kNarrowPassages},
        {channels::kGlobalPath}},
       {"rh_optimizer",
        {channels::kNavState, channels::kMission, channels::kObstacleGrid, channels::kGlobalPath,
         channels::kScanWorld},
-       {channels::kRefTraj, channels::kSolverStats}},
+       {channels::kRefTraj, channels::kSolverStats, channels::kNarrowPassages}},
   };
   return specs;
 }
@@ -188,6 +189,17 @@ MessageDifference difference(const global_path_t& a, const global_path_t& b) {
   return d.largest();
 }
 
+MessageDifference difference(const narrow_passages_t& a, const narrow_passages_t& b) {
+  FieldDifference d;
+  d.time(a.utime, b.utime);
+  d.same(a.frame, b.frame);
+  d.same(a.mission_id, b.mission_id);
+  d.rows(a.centre, b.centre);
+  d.values(a.radius, b.radius);
+  d.values(a.half_height, b.half_height);
+  return d.largest();
+}
+
 MessageDifference difference(const ref_traj_t& a, const ref_traj_t& b) {
   FieldDifference d;
   d.time(a.utime, b.utime);
@@ -231,6 +243,8 @@ MessageDifference message_difference(const std::string& channel, const Bytes& re
   if (channel == channels::kCuboids) return decoded_difference<cuboid_list_t>(recorded, replayed);
   if (channel == channels::kGlobalPath)
     return decoded_difference<global_path_t>(recorded, replayed);
+  if (channel == channels::kNarrowPassages)
+    return decoded_difference<narrow_passages_t>(recorded, replayed);
   if (channel == channels::kRefTraj) return decoded_difference<ref_traj_t>(recorded, replayed);
   if (channel == channels::kSolverStats)
     return decoded_difference<solver_stats_t>(recorded, replayed);

@@ -160,10 +160,11 @@ int main(int argc, char** argv) {
   lcm.subscribeFunction(ofn::channels::kSimClock, &on_sim_clock, &sim_now);
 
   namespace ch = ofn::channels;
-  const std::vector<std::string> channels = {
-      ch::kNavState, ch::kActuatorCmd, ch::kSimClock,     ch::kMission, ch::kVirtualObstacles,
-      ch::kLidarRaw, ch::kScanWorld,   ch::kObstacleGrid, ch::kCuboids, ch::kGlobalPath,
-      ch::kRefTraj,  ch::kSolverStats, ch::kControlStatus};
+  const std::vector<std::string> channels = {ch::kNavState,    ch::kActuatorCmd,      ch::kSimClock,
+                                             ch::kMission,     ch::kVirtualObstacles, ch::kLidarRaw,
+                                             ch::kScanWorld,   ch::kObstacleGrid,     ch::kCuboids,
+                                             ch::kGlobalPath,  ch::kNarrowPassages,   ch::kRefTraj,
+                                             ch::kSolverStats, ch::kControlStatus};
   std::mt19937 rng(42);
   std::uniform_int_distribution<int> byte(0, 255), length(0, 600);
 

@@ -14,7 +14,7 @@ scenario="$REPO/sim/scenarios/bench1.yaml"
 "$BIN/ofn_replay" --log "$WORK/orig/flight.lcm" --config-dir "$REPO/config" --out "$WORK/replay" \
   --log-level error > "$WORK/replay.txt" 2>&1 || { cat "$WORK/replay.txt"; fail "replay differs (exit $?)"; }
 cat "$WORK/replay.txt"
-for ch in SCAN_WORLD OBSTACLE_GRID CUBOIDS GLOBAL_PATH REF_TRAJ SOLVER_STATS; do
+for ch in SCAN_WORLD OBSTACLE_GRID CUBOIDS GLOBAL_PATH NARROW_PASSAGES REF_TRAJ SOLVER_STATS; do
   # recorded == replayed == identical, and not zero: the chain was exercised.
   awk -v ch="$ch" '$1 == ch && $2 > 0 && $2 == $3 && $2 == $4 && $6 == 0 && $7 == 0 { ok = 1 }
                    END { exit !ok }' "$WORK/replay.txt" || fail "$ch not reproduced identically"

@@ -170,5 +170,48 @@ TEST_F(GlobalPlannerServiceTest, BadCuboidsAreRejectedAndCounted) {
   EXPECT_EQ(paths_.back().status, global_path_t::OK);
 }
 
+narrow_passages_t passages(Utime t, int32_t mission_id, double east) {
+  narrow_passages_t m{};
+  m.utime = t;
+  m.frame = "NED";
+  m.mission_id = mission_id;
+  m.centre = {{61.0, east, -(42.7 + 6.096)}};
+  m.radius = {10.0};
+  m.half_height = {3.0};
+  m.num_passages = 1;
+  return m;
+}
+
+TEST_F(GlobalPlannerServiceTest, ThePassagesOfThisMissionAreRoutedRound) {
+  const mission_t plan = mission();
+  send(channels::kMission, plan);
+  send(channels::kNavState, nav(kStart, 0));
+  send(channels::kCuboids, wall(kStart));
+  ASSERT_EQ(paths_.size(), 1u);
+  ASSERT_GE(highest_altitude(paths_.back()), 42.7 + 6.096 - 0.1);  // over the wall's middle
+  // Another mission's passages say nothing about this one.
+  send(channels::kNarrowPassages, passages(kStart, plan.mission_id + 1, 0.0));
+  EXPECT_EQ(paths_.size(), 1u);
+  // The way over the wall's middle is too narrow: the route goes another
+  // way at once (round an end; too sharp for Eq. 10 from here, so it comes
+  // as the geometric guess with NO_PATH).
+  send(channels::kNarrowPassages, passages(kStart, plan.mission_id, 0.0));
+  ASSERT_EQ(paths_.size(), 2u);
+  ASSERT_GE(paths_.back().points.size(), 2u);
+  for (const auto& q : paths_.back().points)
+    if (std::abs(-q[2] - (42.7 + 6.096)) <= 3.0) {
+      EXPECT_GE(std::hypot(q[0] - 61.0, q[1]), 10.0 - 0.1);
+    }
+  // The same list again: no extra plan. A list with a non-finite centre is
+  // rejected and counted.
+  send(channels::kNarrowPassages, passages(kStart, plan.mission_id, 0.0));
+  EXPECT_EQ(paths_.size(), 2u);
+  const int64_t rejected = service_.node().counters().rejected;
+  send(channels::kNarrowPassages,
+       passages(kStart, plan.mission_id, std::numeric_limits<double>::quiet_NaN()));
+  EXPECT_EQ(service_.node().counters().rejected, rejected + 1);
+  EXPECT_EQ(paths_.size(), 2u);
+}
+
 }  // namespace
 }  // namespace ofn::planning

@@ -132,7 +132,7 @@ TEST_F(LogReplay, LockstepFlightReplaysIdenticallyThroughMapperAndPlanners) {
   const ReplayResult result = replay_log(flight_, o);
   SCOPED_TRACE(format_comparison(result));
   EXPECT_TRUE(result.matches());
-  ASSERT_EQ(result.channels.size(), 6u);
+  ASSERT_EQ(result.channels.size(), 7u);
   for (const auto& c : result.channels) {
     EXPECT_EQ(c.identical, c.recorded) << c.channel;
     EXPECT_EQ(c.replayed, c.recorded) << c.channel;
@@ -142,6 +142,7 @@ TEST_F(LogReplay, LockstepFlightReplaysIdenticallyThroughMapperAndPlanners) {
   EXPECT_GT(channel(result, channels::kCuboids).recorded, 10);
   EXPECT_GT(channel(result, channels::kGlobalPath).recorded, 5);
   EXPECT_GT(channel(result, channels::kRefTraj).recorded, 10);
+  EXPECT_GT(channel(result, channels::kNarrowPassages).recorded, 5);
 
   // The replayed log holds the same traffic as the recording, with the
   // replayed services' outputs in place of the recorded ones.

@@ -365,6 +365,33 @@ TEST(Validate, ModesAndStatusesOutsideTheirConstantsAreRejected) {
   EXPECT_NE(validate(p), "");
 }
 
+TEST(Validate, NarrowPassagesNeedMatchingFiniteArrays) {
+  narrow_passages_t m{};
+  m.utime = 1000;
+  m.frame = "NED";
+  m.mission_id = 1;
+  m.centre = {{60, 0, -30}};
+  m.radius = {6.0};
+  m.half_height = {3.0};
+  m.num_passages = 1;
+  EXPECT_EQ(validate(m), "");
+  narrow_passages_t bad = m;
+  bad.radius.clear();
+  EXPECT_NE(validate(bad), "");
+  bad = m;
+  bad.centre[0][1] = std::numeric_limits<double>::infinity();
+  EXPECT_NE(validate(bad), "");
+  bad = m;
+  bad.half_height[0] = 0.0;
+  EXPECT_NE(validate(bad), "");
+  bad = m;
+  bad.num_passages = -1;
+  EXPECT_NE(validate(bad), "");
+  bad = m;
+  bad.frame = "ENU";
+  EXPECT_NE(validate(bad), "");
+}
+
 TEST(Validate, RefTrajRejectsNonIncreasingSampleTimes) {
   ref_traj_t m = good_traj();
   m.sample_time = {0.0, 0.5, 0.5};

@@ -173,6 +173,28 @@ std::string validate(const global_path_t& m) {
   return "";
 }
 
+std::string validate(const narrow_passages_t& m) {
+  if (auto e = check_frame(m.frame); !e.empty()) return e;
+  if (auto e =
+          check_count(m.num_passages, m.centre.size(), MessageLimits::kMaxPassages, "passages");
+      !e.empty())
+    return e;
+  if (m.radius.size() != m.centre.size() || m.half_height.size() != m.centre.size())
+    return "passage arrays differ in length";
+  for (size_t i = 0; i < m.centre.size(); ++i) {
+    const auto& c = m.centre[i];
+    if (c.size() != 3 || !all_finite(c.begin(), c.end()) ||
+        std::abs(c[0]) >= MessageLimits::kMaxCoordinate ||
+        std::abs(c[1]) >= MessageLimits::kMaxCoordinate ||
+        std::abs(c[2]) >= MessageLimits::kMaxCoordinate)
+      return "passage centre not finite or out of range";
+    if (!std::isfinite(m.radius[i]) || !std::isfinite(m.half_height[i]) || m.radius[i] <= 0 ||
+        m.half_height[i] <= 0)
+      return "passage size not finite and positive";
+  }
+  return "";
+}
+
 std::string validate(const ref_traj_t& m) {
   if (auto e = check_frame(m.frame); !e.empty()) return e;
   if (auto e = check_count(m.num_samples, m.sample_time.size(), MessageLimits::kMaxTrajSamples,

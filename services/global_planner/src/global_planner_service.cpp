@@ -85,6 +85,15 @@ std::vector<ObstacleBox> boxes_from(const cuboid_list_t& msg) {
   return boxes;
 }
 
+std::vector<NoGoZone> zones_from(const narrow_passages_t& msg) {
+  std::vector<NoGoZone> zones;
+  zones.reserve(msg.centre.size());
+  for (size_t i = 0; i < msg.centre.size(); ++i)
+    zones.push_back({Vec3(msg.centre[i][0], msg.centre[i][1], msg.centre[i][2]), msg.radius[i],
+                     msg.half_height[i]});
+  return zones;
+}
+
 global_path_t path_message(const PlanResult& result, Utime utime, const PlanResult* geometric_route,
                            const PlanResult* backtrack_route) {
   global_path_t m;
@@ -116,6 +125,11 @@ GlobalPlannerService::GlobalPlannerService(lcm::LCM& lcm, const Clock& clock,
   node_.subscribe<cuboid_list_t>(
       channels::kCuboids, [this](const cuboid_list_t& m) { on_cuboids(m); },
       SubscribeOptions{config_.cuboids_max_age, 0.5});
+  // The whole list of the mission each time, whatever its age: a passage
+  // found narrow stays narrow.
+  node_.subscribe<narrow_passages_t>(
+      channels::kNarrowPassages, [this](const narrow_passages_t& m) { on_passages(m); },
+      SubscribeOptions{0.0, 1.0});
   node_.add_timer(
       1.0 / config_.replan_rate, [this] { replan("periodic"); }, "replan");
   node_.set_state("waiting for mission, nav and cuboids");
@@ -145,6 +159,7 @@ void GlobalPlannerService::on_mission(const mission_t& m) {
   geometric_planner_.emplace(geometric);
   legs_.clear();
   active_leg_ = -1;
+  no_go_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m, accel {:.3f} m/s^2, speed {:.2f} m/s",
                    m.mission_id, m.name, planner_->config().clearance, planner_->config().max_accel,
                    planner_->config().speed);
@@ -155,6 +170,22 @@ void GlobalPlannerService::on_cuboids(const cuboid_list_t& m) {
   const bool changed = !cuboids_ || !same_cuboids(*cuboids_, m);
   cuboids_ = m;
   if (changed) replan("cuboid set changed");
+}
+
+void GlobalPlannerService::on_passages(const narrow_passages_t& m) {
+  // Passages of another mission (an old one, or one this service has not
+  // heard yet) say nothing about this one.
+  if (!mission_ || m.mission_id != mission_->mission_id) return;
+  std::vector<NoGoZone> zones = zones_from(m);
+  const bool changed =
+      zones.size() != no_go_.size() ||
+      !std::equal(zones.begin(), zones.end(), no_go_.begin(), [](const auto& a, const auto& b) {
+        return a.centre == b.centre && a.radius == b.radius && a.half_height == b.half_height;
+      });
+  if (!changed) return;
+  no_go_ = std::move(zones);
+  node_.log().info("{} passage(s) the optimiser cannot fly through", no_go_.size());
+  replan("narrow passages changed");
 }
 
 void GlobalPlannerService::replan(const char* why) {
@@ -180,6 +211,7 @@ void GlobalPlannerService::replan(const char* why) {
   request.goal = leg->to;
   request.leg_from = leg->from;
   request.obstacles = boxes_from(*cuboids_);
+  request.no_go = no_go_;
   PlanResult result = planner_->plan(request);
   std::optional<PlanResult> geometric, backtrack;
   if (result.status == PlanStatus::kNoPath) geometric = geometric_planner_->plan(request);

@@ -9,6 +9,7 @@
 
 #include "ofn/common/channels.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
+#include "ofn/common/validate.hpp"
 
 namespace ofn::rh {
 namespace {
@@ -160,6 +161,17 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
     d.climb_extra_time = v.number_in("climb_extra_time", d.climb_extra_time, 0.0, 600.0);
     v.finish();
   }
+  {
+    YamlReader v = r.child("passages");
+    PassageSettings& d = c.passages;
+    d.enabled = v.boolean("enabled", d.enabled);
+    d.look_distance = v.number_in("look_distance", d.look_distance, 1.0, 1e4);
+    d.max_shift = v.number_in("max_shift", d.max_shift, 0.1, 50.0);
+    d.max_passages = static_cast<int>(v.integer("max_passages", d.max_passages));
+    if (d.max_passages < 1 || d.max_passages > MessageLimits::kMaxPassages)
+      v.fail("max_passages", "expected 1.." + std::to_string(MessageLimits::kMaxPassages));
+    v.finish();
+  }
   YamlReader g = r.child("commit");
   CommitSettings& k = c.commit;
   k.commit_time = g.number_in("commit_time", k.commit_time, 0.0, 10.0);
@@ -251,7 +263,8 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
       visibility_(1.0, config_.visibility_band),
       scan_supply_(config_.scan_supply),
       field_(config_.field),
-      recovery_(config_.recovery) {
+      recovery_(config_.recovery),
+      passages_(config_.passages.max_passages) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
       SubscribeOptions{config_.nav_max_age, 0.5});
@@ -271,6 +284,8 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
         SubscribeOptions{config_.grid_max_age, 0.5});
   node_.add_timer(
       1.0 / config_.rate, [this] { tick(); }, "rh_step");
+  node_.add_timer(
+      1.0, [this] { publish_passages(node_.now()); }, "narrow_passages");
   node_.set_state("waiting for mission, nav and grid");
 }
 
@@ -287,6 +302,7 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   switch_.reset();
   visibility_.clear();
   shadows_.clear();
+  passages_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
                    m.mission_id, m.name, m.limits.clearance, config_.optimizer.clearance_margin,
                    m.limits.max_accel);
@@ -428,6 +444,42 @@ void RhOptimizerService::restart_planning() {
   stalled_ = false;
 }
 
+narrow_passages_t passages_message(const std::vector<NarrowPassage>& passages, int32_t mission_id,
+                                   Utime utime) {
+  narrow_passages_t m;
+  m.utime = utime;
+  m.frame = "NED";
+  m.mission_id = mission_id;
+  m.num_passages = static_cast<int32_t>(passages.size());
+  for (const NarrowPassage& p : passages) {
+    m.centre.push_back({p.centre.x(), p.centre.y(), p.centre.z()});
+    m.radius.push_back(p.radius);
+    m.half_height.push_back(p.half_height);
+  }
+  return m;
+}
+
+void RhOptimizerService::publish_passages(Utime now) {
+  if (!mission_ || !config_.passages.enabled) return;
+  node_.publish(channels::kNarrowPassages,
+                passages_message(passages_.passages(), mission_->mission_id, now));
+}
+
+void RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits) {
+  if (!field_valid_ || (route_kind_ != RouteKind::kForward && route_kind_ != RouteKind::kBacktrack))
+    return;
+  const ClearanceQuery clearance = [this](const Vec3& p) { return field_.query(p); };
+  const double required = limits.clearance + config_.optimizer.clearance_margin;
+  const auto pinch = find_narrow_passage(clearance, recovery_route_, required, config_.passages);
+  if (!pinch || !passages_.add(*pinch)) return;
+  node_.log().warn(
+      "t={:.2f} s the route passes a pinch at ({:.1f}, {:.1f}, {:.1f}) m with {:.2f} m of the "
+      "{:.2f} m clearance: told to the global planner",
+      to_seconds(now), pinch->centre.x(), pinch->centre.y(), pinch->centre.z(), pinch->clearance,
+      required);
+  publish_passages(now);
+}
+
 RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
                                                      const Limits& limits, const Vec3& position,
                                                      const Vec3& velocity, bool engaged) {
@@ -453,6 +505,9 @@ RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
     planner_.reset();
     route_changed_ = true;
     last_step_moving_ = false;
+    // Stuck with a route: if it runs through a gap too narrow to fly, the
+    // look would only bring it back.
+    if (decision.phase == RecoveryPhase::kLooking) check_route_for_pinch(now, limits);
   }
   return decision;
 }

@@ -12,6 +12,7 @@ inline constexpr const char* kScanWorld = "SCAN_WORLD";
 inline constexpr const char* kObstacleGrid = "OBSTACLE_GRID";
 inline constexpr const char* kCuboids = "CUBOIDS";
 inline constexpr const char* kGlobalPath = "GLOBAL_PATH";
+inline constexpr const char* kNarrowPassages = "NARROW_PASSAGES";
 inline constexpr const char* kRefTraj = "REF_TRAJ";
 inline constexpr const char* kSolverStats = "SOLVER_STATS";
 inline constexpr const char* kControlStatus = "CONTROL_STATUS";

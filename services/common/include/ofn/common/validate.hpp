@@ -13,6 +13,7 @@
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/lidar_scan_t.hpp"
 #include "ofn/mission_t.hpp"
+#include "ofn/narrow_passages_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
@@ -34,6 +35,7 @@ struct MessageLimits {
   static constexpr int kMaxPathPoints = 10000;
   static constexpr int kMaxTrajSamples = 20000;
   static constexpr int kMaxSplineKnots = 1000;
+  static constexpr int kMaxPassages = 1000;
   /// Positions farther than this from the origin are not from this mission.
   static constexpr double kMaxCoordinate = 1.0e6;
 };
@@ -59,6 +61,7 @@ std::string validate(const scan_world_t& msg);
 std::string validate(const obstacle_grid_t& msg);
 std::string validate(const cuboid_list_t& msg);
 std::string validate(const global_path_t& msg);
+std::string validate(const narrow_passages_t& msg);
 std::string validate(const ref_traj_t& msg);
 std::string validate(const solver_stats_t& msg);
 std::string validate(const control_status_t& msg);

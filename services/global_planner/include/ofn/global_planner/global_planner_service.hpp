@@ -1,5 +1,6 @@
 #pragma once
-// Binds the global planner to the bus: CUBOIDS, NAV_STATE and MISSION in,
+// Binds the global planner to the bus: CUBOIDS, NAV_STATE, MISSION and
+// NARROW_PASSAGES (what the RH optimiser could not fly through) in,
 // GLOBAL_PATH out once a second and whenever the cuboid set or the target
 // waypoint changes (paper 4.2: the coarse route that warm-starts the RH
 // optimiser). Clearance, acceleration limit and speed come from the
@@ -15,6 +16,7 @@
 #include "ofn/global_path_t.hpp"
 #include "ofn/global_planner/global_planner.hpp"
 #include "ofn/mission_t.hpp"
+#include "ofn/narrow_passages_t.hpp"
 #include "ofn/nav_state_t.hpp"
 
 namespace ofn::planning {
@@ -43,6 +45,9 @@ GlobalPlannerConfig planner_config_for(const GlobalPlannerServiceConfig& config,
 
 std::vector<ObstacleBox> boxes_from(const cuboid_list_t& msg);
 
+/// The no-go zones of a NARROW_PASSAGES message (validated).
+std::vector<NoGoZone> zones_from(const narrow_passages_t& msg);
+
 /// GLOBAL_PATH of a plan; with NO_PATH, `points` carry the geometric route
 /// if one was found (a guess for the optimiser, not a flyable plan), or
 /// else, with BACKTRACK, the route in any direction (out of a dead end).
@@ -62,6 +67,7 @@ class GlobalPlannerService {
   void on_nav(const nav_state_t& m);
   void on_mission(const mission_t& m);
   void on_cuboids(const cuboid_list_t& m);
+  void on_passages(const narrow_passages_t& m);
   void replan(const char* why);
 
   Node node_;
@@ -74,6 +80,8 @@ class GlobalPlannerService {
   std::optional<nav_state_t> nav_;
   std::optional<mission_t> mission_;
   std::optional<cuboid_list_t> cuboids_;
+  // The passages of the current mission the optimiser could not fly.
+  std::vector<NoGoZone> no_go_;
   LegTracker legs_;
   int active_leg_ = -1;
   std::optional<PlanResult> last_plan_;

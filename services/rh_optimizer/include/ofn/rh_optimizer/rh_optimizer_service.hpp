@@ -1,11 +1,11 @@
 #pragma once
 // Binds the RH optimiser to the bus (paper 2.2): NAV_STATE, MISSION,
 // OBSTACLE_GRID and GLOBAL_PATH in; REF_TRAJ and SOLVER_STATS out at a fixed
-// rate. It builds the distance field from the grid, decides when avoidance
-// overrides nominal waypoint guidance (AvoidanceSwitch), and while it does,
-// solves one receding-horizon step per tick and publishes the trajectory
-// the controller follows. Handing back, it publishes a NOMINAL trajectory
-// so the controller resumes waypoint guidance at once.
+// rate, and NARROW_PASSAGES (passages of the global route it found it
+// cannot fly) for the global planner. It builds the distance field from the grid, decides when
+// avoidance overrides nominal waypoint guidance (AvoidanceSwitch), and while it does, solves one
+// receding-horizon step per tick and publishes the trajectory the controller follows. Handing back,
+// it publishes a NOMINAL trajectory so the controller resumes waypoint guidance at once.
 
 #include <optional>
 #include <string>
@@ -19,11 +19,13 @@
 #include "ofn/mapper/distance_field.hpp"
 #include "ofn/mapper/heightfield.hpp"
 #include "ofn/mission_t.hpp"
+#include "ofn/narrow_passages_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
 #include "ofn/rh_optimizer/avoidance_switch.hpp"
 #include "ofn/rh_optimizer/dead_end_recovery.hpp"
+#include "ofn/rh_optimizer/narrow_passage.hpp"
 #include "ofn/rh_optimizer/occlusion.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 #include "ofn/rh_optimizer/scan_supply.hpp"
@@ -85,6 +87,7 @@ struct RhOptimizerServiceConfig {
   CommitSettings commit;  // the safety invariant of every published plan
   SwitchSettings avoidance;
   RecoverySettings recovery;       // out of dead ends
+  PassageSettings passages;        // routes through gaps too narrow to fly, told to the planner
   ScanSupplySettings scan_supply;  // no plans on a map starved of scans
 };
 
@@ -99,6 +102,10 @@ mapping::Heightfield padded_heightfield(const obstacle_grid_t& grid, double pad_
 /// REF_TRAJ of a trajectory: the spline and samples every `period` seconds.
 ref_traj_t trajectory_message(const BsplineTrajectory& trajectory, Utime t0, int8_t mode,
                               double period, Utime utime);
+
+/// NARROW_PASSAGES of a mission's passages.
+narrow_passages_t passages_message(const std::vector<NarrowPassage>& passages, int32_t mission_id,
+                                   Utime utime);
 
 /// Largest distance from a point of `b` (over its first `horizon` metres
 /// from `from`) to the polyline `a`: how much two routes differ where it
@@ -123,6 +130,12 @@ class RhOptimizerService {
   bool refresh_field(Utime now, const Vec3& vehicle);
   void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
   void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
+  /// The mission's passages, for the global planner (on change and 1 Hz).
+  void publish_passages(Utime now);
+  /// On getting stuck: a pinch on the route the planner offers is
+  /// remembered and published, so that the route after the look goes
+  /// another way.
+  void check_route_for_pinch(Utime now, const Limits& limits);
   /// Feeds the dead-end recovery; logs and acts on a change of its phase.
   RecoveryDecision update_recovery(Utime now, const Leg& leg, const Limits& limits,
                                    const Vec3& position, const Vec3& velocity, bool engaged);
@@ -165,6 +178,7 @@ class RhOptimizerService {
   Utime route_kind_utime_ = INT64_MIN;
   std::vector<Vec3> recovery_route_;
   DeadEndRecovery recovery_;
+  PassageMemory passages_;
   bool last_step_moving_ = false;  // the last step committed a plan that moves off
   Utime route_utime_ = INT64_MIN;
   bool route_changed_ = false;
