@@ -431,6 +431,42 @@ TEST(DeadEndRecovery, NoRouteAfterTheLookHoldsTheHoverAndSaysSo) {
   EXPECT_EQ(r.step().phase, RecoveryPhase::kTurning);
 }
 
+// A route after the look through a passage too narrow to fly (the service
+// tells the global planner): the recovery waits for the planner's next
+// route, asking once per route, and takes that one.
+TEST(DeadEndRecovery, ARouteThroughANarrowPassageWaitsForTheNextRoute) {
+  RecoveryRun r;
+  r.run(4.1);
+  int asked = 0;
+  r.in.route_flyable = [&] {
+    ++asked;
+    return asked > 1;  // the first route runs through a pinch
+  };
+  RecoveryDecision d = r.look_finds(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+  EXPECT_EQ(d.phase, RecoveryPhase::kLooking);
+  EXPECT_EQ(asked, 1);
+  EXPECT_EQ(r.run(2.0).phase, RecoveryPhase::kLooking);
+  EXPECT_EQ(asked, 1);  // the same route is not asked about again
+  r.give_route(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+  EXPECT_EQ(r.step().phase, RecoveryPhase::kTurning);
+  EXPECT_EQ(asked, 2);
+  // NO_PATH is never asked about: the climb (or no route) follows at once.
+  RecoveryRun none;
+  none.run(4.1);
+  none.in.route_flyable = [&] {
+    ADD_FAILURE() << "asked about NO_PATH";
+    return false;
+  };
+  EXPECT_NE(none.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kLooking);
+  // Nothing newer within route_timeout of the look: no route, as with none.
+  RecoveryRun waits;
+  waits.run(4.1);
+  waits.in.route_flyable = [] { return false; };
+  waits.look_finds(RouteKind::kForward, {waits.in.position, waits.in.position + Vec3(50, 0, 0)});
+  EXPECT_EQ(waits.run(6.4).phase, RecoveryPhase::kLooking);
+  EXPECT_EQ(waits.run(0.6).phase, RecoveryPhase::kNoRoute);
+}
+
 TEST(DeadEndRecovery, AnEscapeStuckTooOftenEndsInNoRoute) {
   RecoveryRun r;  // max_attempts 2
   for (int attempt = 1; attempt <= 2; ++attempt) {

@@ -79,6 +79,7 @@ void DeadEndRecovery::reset() {
   look_end_.reset();
   turned_ = 0;
   attempts_ = 0;
+  narrow_route_time_ = -1e300;
 }
 
 void DeadEndRecovery::enter(RecoveryPhase phase, std::string reason) {
@@ -162,6 +163,16 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
   return true;
 }
 
+bool DeadEndRecovery::route_since(const RecoveryInput& in, double since) {
+  if (!(in.route_time > since) || !(in.route_time > narrow_route_time_)) return false;
+  const bool leads = in.route == RouteKind::kForward || in.route == RouteKind::kBacktrack;
+  if (leads && in.route_flyable && !in.route_flyable()) {
+    narrow_route_time_ = in.route_time;  // the planner was told: wait for its next route
+    return false;
+  }
+  return true;
+}
+
 void DeadEndRecovery::climb_or_hold(const RecoveryInput& in, const std::string& why) {
   const double ceiling = settings_.climb_ceiling;
   if (!(settings_.climb_step > 0) || !(in.altitude + settings_.climb_tolerance < ceiling)) {
@@ -221,7 +232,8 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
     case RecoveryPhase::kLooking:
       if (!look_end_) {
         if (turned_through(in)) look_end_ = in.time;
-      } else if (in.time - *look_end_ >= settings_.route_wait && in.route_time >= *look_end_) {
+      } else if (in.time - *look_end_ >= settings_.route_wait &&
+                 route_since(in, *look_end_ - 1e-9)) {
         if (!take_route(in)) climb_or_hold(in, "no route after the look-around");
       } else if (in.time - *look_end_ >= settings_.route_timeout) {
         enter(RecoveryPhase::kNoRoute, "no new route after the look-around: holding the hover");
@@ -260,7 +272,7 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
       // climb ends at its altitude (or where the time allowed got it) with
       // a look around. Only a climb done counts as progress: one the gate
       // refused leaves the looks counting to "no route".
-      if (in.route_time > climb_start_ && take_route(in)) break;
+      if (route_since(in, climb_start_) && take_route(in)) break;
       turned_through(in);
       const bool turned_all_round = std::abs(turned_) >= settings_.look_turn;
       const bool reached =
@@ -288,7 +300,7 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
     case RecoveryPhase::kNoRoute:
       // A route may appear later (an obstacle gone, a better map): taken up
       // while looks remain.
-      if (attempts_ < settings_.max_attempts && in.route_time > look_start_) take_route(in);
+      if (attempts_ < settings_.max_attempts && route_since(in, look_start_)) take_route(in);
       break;
   }
   return decision_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include <fmt/format.h>
@@ -465,19 +466,26 @@ void RhOptimizerService::publish_passages(Utime now) {
                 passages_message(passages_.passages(), mission_->mission_id, now));
 }
 
-void RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits) {
-  if (!field_valid_ || (route_kind_ != RouteKind::kForward && route_kind_ != RouteKind::kBacktrack))
-    return;
+bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits) {
+  if (!field_valid_) return false;
+  // On the field the plans are made on, after the look: the shadows
+  // behind what was seen (occlusion) it cleared are gone, those left are
+  // what the optimiser will meet. (Checked when the vehicle got stuck,
+  // before the look, a gap they closed then was open after it: dense seed
+  // 68 lost its way so.)
   const ClearanceQuery clearance = [this](const Vec3& p) { return field_.query(p); };
   const double required = limits.clearance + config_.optimizer.clearance_margin;
   const auto pinch = find_narrow_passage(clearance, recovery_route_, required, config_.passages);
-  if (!pinch || !passages_.add(*pinch)) return;
+  // One the planner knows already is not its doing (a zone round the
+  // start, which routes may leave): the route is taken.
+  if (!pinch || !passages_.add(*pinch)) return false;
   node_.log().warn(
       "t={:.2f} s the route passes a pinch at ({:.1f}, {:.1f}, {:.1f}) m with {:.2f} m of the "
       "{:.2f} m clearance: told to the global planner",
       to_seconds(now), pinch->centre.x(), pinch->centre.y(), pinch->centre.z(), pinch->clearance,
       required);
   publish_passages(now);
+  return true;
 }
 
 RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
@@ -496,6 +504,7 @@ RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
   in.route_time = route_kind_utime_ == INT64_MIN ? -1e300 : to_seconds(route_kind_utime_);
   in.route_points = &recovery_route_;
   in.leg = GuidanceFrame::from_leg(leg.from, leg.to);
+  in.route_flyable = [&] { return !check_route_for_pinch(now, limits); };
   RecoveryDecision decision = recovery_.update(in);
   if (decision.changed) {
     node_.log().warn("t={:.2f} s recovery: {}: {}", in.time, to_string(decision.phase),
@@ -505,9 +514,6 @@ RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
     planner_.reset();
     route_changed_ = true;
     last_step_moving_ = false;
-    // Stuck with a route: if it runs through a gap too narrow to fly, the
-    // look would only bring it back.
-    if (decision.phase == RecoveryPhase::kLooking) check_route_for_pinch(now, limits);
   }
   return decision;
 }

@@ -22,6 +22,9 @@
 //       which the rest of the route heads along the leg, then normal
 //       planning (left to itself, the forward-only optimiser would take the
 //       shorter way straight on, back into the dead end);
+//     - one through a passage too narrow to fly (the caller's
+//       route_flyable says so, and tells the global planner): wait for a
+//       newer route;
 //     - none: climb straight up by `climb_step`, turning the heading on
 //       the way (a climb that turned all round needs no look after it),
 //       then look around again, up to `climb_ceiling`. A top no beam went over counts as reaching
@@ -37,6 +40,7 @@
 // Every plan flown in recovery passes the same commit gate as any other.
 // Pure core: world NED, SI, time in seconds of the caller's clock.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -101,6 +105,12 @@ struct RecoveryInput {
   // world NED, vehicle first: the route's points, whatever its kind
   const std::vector<Vec3>* route_points = nullptr;
   GuidanceFrame leg;  // the mission leg's frame
+  /// Asked once per route, when a route is about to be taken (after a
+  /// look, on the way up a climb, or after no route):
+  /// false when it runs through a passage too narrow to fly that the
+  /// global planner has just been told of (find_narrow_passage), so a
+  /// newer route is waited for. Empty: every route can be flown.
+  std::function<bool()> route_flyable;
 };
 
 struct RecoveryDecision {
@@ -168,6 +178,10 @@ class DeadEndRecovery {
   /// Takes up the route of `in` if it leads anywhere: normal planning or
   /// an escape. Returns false when there is none.
   bool take_route(const RecoveryInput& in);
+  /// Whether the planner's route (any kind) is newer than `since` and may
+  /// be taken: one that runs through a passage too narrow to fly
+  /// (route_flyable) is remembered by its stamp and never taken.
+  bool route_since(const RecoveryInput& in, double since);
   /// After a look that found no route: a climb if one is left below the
   /// ceiling, else no route. `why` says what the look found.
   void climb_or_hold(const RecoveryInput& in, const std::string& why);
@@ -188,6 +202,9 @@ class DeadEndRecovery {
   RecoveryPhase after_turn_ = RecoveryPhase::kIdle;  // what follows kTurning
   int attempts_ = 0;
   double climb_start_ = 0;  // s, when the climb began
+  // The stamp of the last route found to run through a narrow passage:
+  // only a newer one is taken.
+  double narrow_route_time_ = -1e300;
 };
 
 }  // namespace ofn::rh

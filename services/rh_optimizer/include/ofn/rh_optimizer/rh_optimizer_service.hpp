@@ -132,10 +132,10 @@ class RhOptimizerService {
   void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
   /// The mission's passages, for the global planner (on change and 1 Hz).
   void publish_passages(Utime now);
-  /// On getting stuck: a pinch on the route the planner offers is
-  /// remembered and published, so that the route after the look goes
-  /// another way.
-  void check_route_for_pinch(Utime now, const Limits& limits);
+  /// The route the recovery is about to take after a look: a new pinch on
+  /// it is remembered and published, so that the planner's next route goes
+  /// another way. True if one was.
+  bool check_route_for_pinch(Utime now, const Limits& limits);
   /// Feeds the dead-end recovery; logs and acts on a change of its phase.
   RecoveryDecision update_recovery(Utime now, const Leg& leg, const Limits& limits,
                                    const Vec3& position, const Vec3& velocity, bool engaged);
