@@ -164,6 +164,34 @@ TEST(ViewState, TrueClearanceFromInjectedObstacles) {
   EXPECT_EQ(s["obstacles"]["list"][0]["kind"], "box");
 }
 
+TEST(ViewState, NarrowPassagesOfTheMissionAreShown) {
+  ViewState view;
+  ASSERT_EQ(view.on_mission(mission()), "");
+  ASSERT_EQ(view.on_nav_state(nav(1.0, 0.0)), "");
+  EXPECT_TRUE(view.snapshot()["narrow_passages"].empty());
+  narrow_passages_t m{};
+  m.utime = to_utime(1.0);
+  m.frame = "NED";
+  m.mission_id = mission().mission_id;
+  m.centre = {{40.0, -5.0, -30.0}};
+  m.radius = {6.5};
+  m.half_height = {3.0};
+  m.num_passages = 1;
+  ASSERT_EQ(view.on_narrow_passages(m), "");
+  auto s = view.snapshot();
+  ASSERT_EQ(s["narrow_passages"].size(), 1u);
+  EXPECT_DOUBLE_EQ(s["narrow_passages"][0]["centre"][1].get<double>(), -5.0);
+  EXPECT_DOUBLE_EQ(s["narrow_passages"][0]["radius"].get<double>(), 6.5);
+  // Another mission's list is not this one's; a bad one is rejected.
+  m.utime = to_utime(2.0);
+  m.mission_id += 1;
+  ASSERT_EQ(view.on_narrow_passages(m), "");
+  EXPECT_TRUE(view.snapshot()["narrow_passages"].empty());
+  m.utime = to_utime(3.0);
+  m.radius = {-1.0};
+  EXPECT_NE(view.on_narrow_passages(m), "");
+}
+
 TEST(ViewState, GridCellsAreTheOccupiedOnesNearestFirst) {
   ViewStateConfig config;
   config.max_grid_cells = 2;

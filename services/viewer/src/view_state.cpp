@@ -95,8 +95,9 @@ void ViewState::start_new_timeline() {
   path_.reset();
   cuboids_.reset();
   grid_.reset();
+  passages_.reset();
   last_nav_ = last_status_ = last_ref_ = last_solver_ = last_path_ = last_cuboids_ = last_grid_ =
-      last_mission_ = last_obstacles_ = INT64_MIN;
+      last_mission_ = last_obstacles_ = last_passages_ = INT64_MIN;
 }
 
 std::string ViewState::on_nav_state(const nav_state_t& msg) {
@@ -140,6 +141,13 @@ std::string ViewState::on_global_path(const global_path_t& msg) {
   if (auto why = accept(channels::kGlobalPath, msg, msg.utime, last_path_); !why.empty())
     return why;
   path_ = msg;
+  return "";
+}
+
+std::string ViewState::on_narrow_passages(const narrow_passages_t& msg) {
+  if (auto why = accept(channels::kNarrowPassages, msg, msg.utime, last_passages_); !why.empty())
+    return why;
+  passages_ = msg;
   return "";
 }
 
@@ -283,6 +291,18 @@ json ViewState::snapshot() const {
   } else {
     s["global_path"] = nullptr;
   }
+
+  // The passages the RH optimiser found too narrow to fly, which the
+  // global planner routes round (of the mission the list names).
+  json passages = json::array();
+  if (passages_ && (!mission_ || passages_->mission_id == mission_->mission_id))
+    for (size_t i = 0; i < passages_->centre.size(); ++i)
+      passages.push_back(
+          json{{"centre", json::array({passages_->centre[i][0], passages_->centre[i][1],
+                                       passages_->centre[i][2]})},
+               {"radius", passages_->radius[i]},
+               {"half_height", passages_->half_height[i]}});
+  s["narrow_passages"] = passages;
 
   json cuboids = json::array();
   if (cuboids_)

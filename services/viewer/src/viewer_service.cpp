@@ -32,6 +32,12 @@ ViewerService::ViewerService(lcm::LCM& lcm, const Clock& clock, ViewStateConfig 
       channels::kGlobalPath,
       [this](const global_path_t& m) { take(channels::kGlobalPath, view_.on_global_path(m)); },
       any_time);
+  node_.subscribe<narrow_passages_t>(
+      channels::kNarrowPassages,
+      [this](const narrow_passages_t& m) {
+        take(channels::kNarrowPassages, view_.on_narrow_passages(m));
+      },
+      any_time);
   node_.subscribe<cuboid_list_t>(
       channels::kCuboids,
       [this](const cuboid_list_t& m) { take(channels::kCuboids, view_.on_cuboids(m)); }, any_time);

@@ -7,6 +7,7 @@ const COLOURS = {
   trail: "#1f5fbf", vehicle: "#000000", route: "#2a9d2a", plan: "#e07b00", stop: "#c0182a",
   obstacle: "rgba(122,122,122,0.45)", obstacleEdge: "#5a5a5a", cuboid: "#8e44ad",
   grid: "#c8b48c", waypoint: "#008b8b", axis: "#888888", background: "#fbfbf8", ground: "#8b6b3d",
+  passage: "#c0182a",
 };
 const METRES_PER_FOOT = 0.3048;
 
@@ -140,6 +141,12 @@ function drawTop(s) {
   ctx.strokeStyle = COLOURS.cuboid; ctx.lineWidth = 1.5;
   for (const c of s.cuboids)
     ctx.strokeRect(T.x(c.min[0]), T.y(c.max[1]), (c.max[0] - c.min[0]) * T.k, (c.max[1] - c.min[1]) * T.k);
+  // Passages too narrow to fly: the global planner routes round them.
+  ctx.save(); ctx.strokeStyle = COLOURS.passage; ctx.lineWidth = 1.5; ctx.setLineDash([5, 3]);
+  for (const p of s.narrow_passages || []) {
+    ctx.beginPath(); ctx.arc(T.x(p.centre[0]), T.y(p.centre[1]), Math.max(3, p.radius * T.k), 0, 2 * Math.PI); ctx.stroke();
+  }
+  ctx.restore();
   if (s.mission) {
     ctx.strokeStyle = COLOURS.waypoint; ctx.lineWidth = 2;
     for (const w of s.mission.waypoints) { ctx.beginPath(); ctx.arc(T.x(w[0]), T.y(w[1]), 6, 0, 2 * Math.PI); ctx.stroke(); }
@@ -229,7 +236,9 @@ function readouts(s) {
   setText("ro-plan", s.ref_traj ? s.ref_traj.mode + ", " + fmt(s.ref_traj.age, 1) + " s old" : "-", s.ref_traj && s.ref_traj.stale);
   const stop = s.ref_traj && s.ref_traj.safe_stop;
   setText("ro-stop", stop ? fmt(stop.distance * scale, 1) + " " + u + " in " + fmt(stop.time, 1) + " s" : "-");
-  setText("ro-route", s.global_path ? s.global_path.status + ", " + s.global_path.points.length + " points" : "-", s.global_path && s.global_path.stale);
+  const narrow = (s.narrow_passages || []).length;
+  setText("ro-route", (s.global_path ? s.global_path.status + ", " + s.global_path.points.length + " points" : "-") +
+    (narrow ? ", " + narrow + " passage" + (narrow > 1 ? "s" : "") + " too narrow" : ""), s.global_path && s.global_path.stale);
   setText("ro-map", s.cuboids.length + " cuboids" + (s.grid ? ", " + s.grid.occupied + " grid cells" : ""));
   setText("ro-trail", s.trail.length + " points, " + fmt(s.trail_length * scale, 0) + " " + u);
   // The node's count includes the view's own (stamp order) rejections.

@@ -27,6 +27,7 @@
 #include "ofn/cuboid_list_t.hpp"
 #include "ofn/global_path_t.hpp"
 #include "ofn/mission_t.hpp"
+#include "ofn/narrow_passages_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
@@ -86,6 +87,7 @@ class ViewState {
   std::string on_obstacle_grid(const obstacle_grid_t& msg);
   std::string on_mission(const mission_t& msg);
   std::string on_virtual_obstacles(const virtual_obstacles_t& msg);
+  std::string on_narrow_passages(const narrow_passages_t& msg);
 
   /// Counts a message the bus layer could not even decode.
   void count_rejection(const std::string& channel, const std::string& reason);
@@ -127,12 +129,14 @@ class ViewState {
   std::optional<obstacle_grid_t> grid_;
   std::optional<mission_t> mission_;
   std::optional<virtual_obstacles_t> obstacles_;
+  std::optional<narrow_passages_t> passages_;
   world::World truth_;  // the injected obstacles, for the true clearance
 
   // Newest accepted stamp per channel (INT64_MIN: none yet).
   Utime last_nav_ = INT64_MIN, last_status_ = INT64_MIN, last_ref_ = INT64_MIN,
         last_solver_ = INT64_MIN, last_path_ = INT64_MIN, last_cuboids_ = INT64_MIN,
-        last_grid_ = INT64_MIN, last_mission_ = INT64_MIN, last_obstacles_ = INT64_MIN;
+        last_grid_ = INT64_MIN, last_mission_ = INT64_MIN, last_obstacles_ = INT64_MIN,
+        last_passages_ = INT64_MIN;
 };
 
 }  // namespace ofn::viewer
