@@ -24,6 +24,7 @@
 #include "ofn/global_path_t.hpp"
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/mission_t.hpp"
+#include "ofn/narrow_passages_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
@@ -97,6 +98,8 @@ struct FlightRecord {
   double last_cuboids_t = 0;
   size_t scan_points_seen = 0;
   int paths = 0;
+  // Passages the RH optimiser found too narrow to fly (its last list).
+  int narrow_passages = 0;
   std::vector<double> solve_times;
   std::map<int, int> solver_status_count;
   std::vector<TimeSpan> recovery;
@@ -247,6 +250,10 @@ class LogDecoder {
     if (channel == channels::kGlobalPath)
       return on<global_path_t>(e,
                                [this](auto& m) { tables_.path(rel(m.utime), record_.paths++, m); });
+    if (channel == channels::kNarrowPassages)
+      return on<narrow_passages_t>(e, [this](auto& m) {
+        if (validate(m).empty()) record_.narrow_passages = m.num_passages;
+      });
     if (channel == channels::kRefTraj)
       return on<ref_traj_t>(e, [this](auto& m) {
         // A plan sent as its spline alone is tabled as its receivers sample it.
@@ -442,6 +449,7 @@ nlohmann::ordered_json summary_json(const FlightRecord& record, const Judged& j,
   json["scan_to_plan_p99"] = json_number(percentile(j.scan_to_plan, 0.99));
   json["scan_to_plan_max"] = json_number(percentile(j.scan_to_plan, 1.0));
   json["recovery_time"] = s.recovery_time;
+  json["narrow_passages"] = record.narrow_passages;
   json["outcome"] = to_string(result.verdict.outcome);
   json["success"] = result.verdict.success;
   json["failures"] = result.verdict.failures;
@@ -531,8 +539,10 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
       << record.count(solver_stats_t::DEFERRED) << ", looking around "
       << record.count(solver_stats_t::LOOKING_AROUND) << ", no route "
       << record.count(solver_stats_t::NO_ROUTE) << "; " << std::setprecision(1) << s.recovery_time
-      << " s in dead-end recovery\n"
-      << std::setprecision(2);
+      << " s in dead-end recovery";
+    if (record.narrow_passages > 0)
+      t << "; " << record.narrow_passages << " passage(s) too narrow to fly, routed round";
+    t << "\n" << std::setprecision(2);
   } else {
     t << "  RH optimiser      : never engaged (nominal waypoint guidance throughout)\n";
   }

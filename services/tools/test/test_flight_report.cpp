@@ -16,6 +16,7 @@
 #include "ofn/common/scenario.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/heartbeat_t.hpp"
+#include "ofn/narrow_passages_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/solver_stats_t.hpp"
 #include "ofn/tools/flight_report.hpp"
@@ -166,11 +167,26 @@ TEST_F(FlightReport, RecoveryTimeCountsLooksEscapesAndClimbs) {
     steps(5.1, 8.0, solver_stats_t::SOLVED, "climbing: solved: climbing");
     steps(10.0, 12.0, solver_stats_t::BRAKING, "escaping: braking");
     steps(14.0, 15.0, solver_stats_t::SOLVED, "solved");
+    // The optimiser's list of passages too narrow to fly: the last says two.
+    for (int count : {0, 1, 2}) {
+      narrow_passages_t m{};
+      m.utime = t0 + (9 + count) * kMicrosPerSecond;
+      m.frame = "NED";
+      for (int i = 0; i < count; ++i) {
+        m.centre.push_back({40.0 + 10 * i, 0.0, -30.0});
+        m.radius.push_back(6.5);
+        m.half_height.push_back(3.0);
+      }
+      m.num_passages = count;
+      write(log, channels::kNarrowPassages, m, m.utime);
+    }
   }
   const ReportResult result =
       write_flight_report(path, (dir_ / "report").string(), open, PseudoControlBound{});
   // 3.0-8.0 (a look, then a climb) and 10.0-12.0 (an escape).
   EXPECT_NEAR(result.summary.recovery_time, 7.0, 1e-3);
+  const nlohmann::json json = read_json(dir_ / "report" / "summary.json");
+  EXPECT_EQ(json.at("narrow_passages"), 2);
 }
 
 // A scenario named with quotes, backslashes and a line break, a log path
