@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Dense fields and trap courses in their short form: three dense random
+# Dense fields and trap courses in their short form: two dense random
 # fields of fixed seeds (bench/random_field.py --dense, which may be sealed)
 # and sim/scenarios/trap_closing_gap.yaml (a pop-up closes the gap the
 # vehicle is heading for), each flown once in lockstep for at most 100 s of
@@ -17,8 +17,11 @@
 # and reach the goal. Out of the yard there is only the way over a wall:
 # after a look that finds no route the recovery climbs to look over them;
 # the vehicle must have crossed the start gate, outside the yard, by 160 s.
+# Dense seed 158 gets stuck in front of a gap its global route runs
+# through and its RH optimiser cannot fly: the optimiser must have told the
+# planner of at least one such passage (NARROW_PASSAGES) by 100 s.
 source "$(dirname "$0")/common.sh"
-SEEDS="1 2"
+SEEDS="1 158"
 # Simulated seconds per flight: the course takes 60 s unobstructed and the
 # avoidance happens within the first 100 s; a flight that stops hovers until
 # the scenario's 200 s limit, which would cost minutes of wall time for
@@ -95,9 +98,12 @@ for name in names:
         if outcome != "success":
             print("%s: %s, but a route exists round the outside" % (name, outcome))
             ok = False
+    if name == "dense-158" and s.get("narrow_passages", 0) < 1:
+        print("%s: no passage too narrow to fly was told to the planner" % name)
+        ok = False
     if name == "trap_yard" and s.get("gate_start_t") is None:
         print("%s: %s, still inside the yard (start gate not crossed)" % (name, outcome))
         ok = False
 sys.exit(0 if ok else 1)
 PY
-pass "two dense fields, the closing gap, the cul-de-sac and the yard flown with no clearance violation and no envelope excursion; out of the cul-de-sac to the goal, out of the yard over a wall"
+pass "two dense fields, the closing gap, the cul-de-sac and the yard flown with no clearance violation and no envelope excursion; out of the cul-de-sac to the goal, out of the yard over a wall, a narrow passage told to the planner"
