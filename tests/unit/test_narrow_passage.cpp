@@ -48,7 +48,30 @@ TEST(NarrowPassage, AGapNarrowerThanTwiceTheClearanceIsAPinch) {
   // Any way through the gap passes within the radius of the centre.
   EXPECT_GE(pinch->radius, 6.0);
   EXPECT_LT(pinch->radius, kRequired + 1.0);
-  EXPECT_DOUBLE_EQ(pinch->half_height, PassageSettings{}.max_shift);
+  // The zone is the gap's column: from at least 40 m below the route (the
+  // search's reach; the blocks stand on the ground) up to where the
+  // clearance over the 60 m tops is reached (just above them: the gap
+  // lacks little), and no higher.
+  const double top = -(pinch->centre.z() - pinch->half_height);
+  const double bottom = -(pinch->centre.z() + pinch->half_height);
+  EXPECT_LE(bottom, kLegAltitude - 40.0 + 1e-6);
+  EXPECT_GT(top, 60.0);
+  EXPECT_LE(top, 60.0 + kRequired + 1.5);
+}
+
+TEST(NarrowPassage, TheColumnOfALowGapEndsWhereItCanBeFlownOver) {
+  // Blocks 34 m tall, the route at 30 m: the zone ends where the
+  // clearance over the gap is reached, so a route over the blocks (at R_s
+  // above them) stays open.
+  const ClearanceQuery clearance =
+      field_with({Box{50, 70, -40, -6, 34.0f}, Box{50, 70, 6, 40, 34.0f}});
+  const auto pinch = find_narrow_passage(clearance, route_north(0, 120, 0.0), kRequired);
+  ASSERT_TRUE(pinch.has_value());
+  const double top = -(pinch->centre.z() - pinch->half_height);
+  EXPECT_GT(top, 34.0);
+  EXPECT_LT(top, 34.0 + kBenchmarkLimits.clearance);
+  EXPECT_FALSE(
+      find_narrow_passage(clearance, route_north(0, 120, 0.0), kRequired, PassageSettings{false}));
 }
 
 TEST(NarrowPassage, AWideEnoughGapIsNoPinchWhereverTheRouteCrossesIt) {

@@ -10,6 +10,8 @@ namespace {
 // max_shift is reached well within them.
 constexpr int kAscentSteps = 30;
 constexpr double kMaxStep = 0.5;  // m
+// Spacing of the samples over the cross-section before the ascent.
+constexpr double kSampleSpacing = 0.5;  // m
 
 struct Crossing {
   bool passable = false;
@@ -17,12 +19,44 @@ struct Crossing {
   double best_distance = -1e300;
 };
 
-// Climbs the clearance within the plane through `point` normal to
-// `tangent`, at most `max_shift` from `point`.
+// Whether any point of the cross-section through `point` normal to
+// `tangent` within `max_shift` of it has `required` clearance; `level`:
+// only the horizontal line across the route at the point's altitude. The
+// section is sampled every kSampleSpacing first (a gradient climb from the
+// route point alone follows the slope up a nearby top and gives up, where
+// a step sideways would have been clear), then the clearance is climbed
+// from the best sample within the section.
 Crossing cross(const ClearanceQuery& clearance, const Vec3& point, const Vec3& tangent,
-               double required, double max_shift) {
+               double required, double max_shift, bool level = false) {
   Crossing c;
-  Vec3 p = point;
+  auto sample = [&](const Vec3& p) {
+    const double d = clearance(p).distance;
+    if (std::isfinite(d) && d > c.best_distance) {
+      c.best_distance = d;
+      c.best = p;
+    }
+    return std::isfinite(d) && d >= required;
+  };
+  if (sample(point)) {
+    c.passable = true;
+    return c;
+  }
+  // Across (horizontal) and, unless level, the section's other axis.
+  Vec3 across = tangent.cross(Vec3::UnitZ());
+  across = across.norm() > 1e-6 ? across.normalized() : Vec3::UnitX();
+  const Vec3 other = across.cross(tangent).normalized();
+  const int n = static_cast<int>(std::floor(max_shift / kSampleSpacing));
+  for (int a = -n; a <= n; ++a)
+    for (int b = level ? 0 : -n; b <= (level ? 0 : n); ++b) {
+      const Vec3 offset = kSampleSpacing * (a * across + b * other);
+      if (offset.norm() > max_shift || (a == 0 && b == 0)) continue;
+      if (sample(point + offset)) {
+        c.passable = true;
+        return c;
+      }
+    }
+  if (c.best_distance == -1e300) return c;
+  Vec3 p = c.best;
   for (int i = 0; i < kAscentSteps; ++i) {
     const mapping::DistanceSample d = clearance(p);
     if (!std::isfinite(d.distance)) return c;
@@ -34,9 +68,10 @@ Crossing cross(const ClearanceQuery& clearance, const Vec3& point, const Vec3& t
       c.passable = true;
       return c;
     }
-    Vec3 across = d.gradient - d.gradient.dot(tangent) * tangent;
-    if (!across.allFinite() || across.norm() < 1e-6) return c;
-    const Vec3 next = p + across.normalized() * std::min(kMaxStep, required - d.distance + 0.05);
+    Vec3 up = d.gradient - d.gradient.dot(tangent) * tangent;
+    if (level) up -= up.dot(other) * other;
+    if (!up.allFinite() || up.norm() < 1e-6) return c;
+    const Vec3 next = p + up.normalized() * std::min(kMaxStep, required - d.distance + 0.05);
     if ((next - point).norm() > max_shift) return c;
     p = next;
   }
@@ -65,10 +100,33 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
     passage.clearance = c.best_distance;
     // A route through the pinch crosses the plane where it is free: within
     // the widest spot's clearance of it (at least a metre, for a route
-    // point inside an obstacle). Above and below, the search reached
-    // max_shift without the clearance.
+    // point inside an obstacle).
     passage.radius = std::max(1.0, c.best_distance) + 0.5;
-    passage.half_height = settings.max_shift;
+    // How far up and down the gap stays too narrow, crossed level at each
+    // altitude: a gap between two tall obstacles is one all the way up to
+    // the lower top, and a route at another altitude (a climbing vehicle's)
+    // would otherwise run through it again just above or below.
+    const Vec3 level_tangent = Vec3(direction.x(), direction.y(), 0.0).norm() > 1e-6
+                                   ? Vec3(direction.x(), direction.y(), 0.0).normalized()
+                                   : direction.normalized();
+    auto extent = [&](double sign) {
+      double reach = 0;
+      for (double dz = settings.extent_step; dz <= settings.max_extent + 1e-9;
+           dz += settings.extent_step) {
+        const Vec3 p = route[k] + Vec3(0.0, 0.0, sign * dz);
+        if (cross(clearance, p, level_tangent, required, settings.max_shift, true).passable) break;
+        reach = dz;
+      }
+      return reach;
+    };
+    // Searched about the route point, as the pinch was: about the widest
+    // spot, up to max_shift aside, a section could reach a clear point
+    // the route's own could not.
+    const double up = extent(-1.0), down = extent(1.0);  // NED: up is -z
+    passage.centre.z() = route[k].z() + 0.5 * (down - up);
+    // The column's ends are known to a step; above and below them the gap
+    // can be crossed level.
+    passage.half_height = 0.5 * (up + down) + settings.extent_step;
     // A pinch round the route's start (the vehicle, stopped in a narrow
     // spot) cannot be routed round: the planner lets routes leave it. Look
     // for one farther on.

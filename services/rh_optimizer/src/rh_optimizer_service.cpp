@@ -168,6 +168,8 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
     d.enabled = v.boolean("enabled", d.enabled);
     d.look_distance = v.number_in("look_distance", d.look_distance, 1.0, 1e4);
     d.max_shift = v.number_in("max_shift", d.max_shift, 0.1, 50.0);
+    d.max_extent = v.number_in("max_extent", d.max_extent, 0.0, 500.0);
+    d.extent_step = v.number_in("extent_step", d.extent_step, 0.1, 50.0);
     d.max_passages = static_cast<int>(v.integer("max_passages", d.max_passages));
     if (d.max_passages < 1 || d.max_passages > MessageLimits::kMaxPassages)
       v.fail("max_passages", "expected 1.." + std::to_string(MessageLimits::kMaxPassages));
@@ -479,11 +481,14 @@ bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits) 
   // One the planner knows already is not its doing (a zone round the
   // start, which routes may leave): the route is taken.
   if (!pinch || !passages_.add(*pinch)) return false;
+  const double ground = config_.optimizer.ground_altitude;
   node_.log().warn(
-      "t={:.2f} s the route passes a pinch at ({:.1f}, {:.1f}, {:.1f}) m with {:.2f} m of the "
-      "{:.2f} m clearance: told to the global planner",
-      to_seconds(now), pinch->centre.x(), pinch->centre.y(), pinch->centre.z(), pinch->clearance,
-      required);
+      "t={:.2f} s the route passes a pinch with {:.2f} m of the {:.2f} m clearance: told to the "
+      "global planner (no route within {:.1f} m of ({:.1f}, {:.1f}) m north/east, {:.1f} to "
+      "{:.1f} m above the ground)",
+      to_seconds(now), pinch->clearance, required, pinch->radius, pinch->centre.x(),
+      pinch->centre.y(), -(pinch->centre.z() + pinch->half_height) - ground,
+      -(pinch->centre.z() - pinch->half_height) - ground);
   publish_passages(now);
   return true;
 }

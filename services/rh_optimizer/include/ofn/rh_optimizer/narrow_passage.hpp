@@ -26,22 +26,29 @@ struct PassageSettings {
   bool enabled = true;
   double look_distance = 60.0;  // m along the route from its start that are checked
   double max_shift = 3.0;       // m across the route a trajectory may pass from its points
-  int max_passages = 16;        // remembered per mission; the oldest go first
+  double max_extent = 40.0;     // m up and down from a pinch searched for more of it
+  double extent_step = 1.0;     // m between the altitudes of that search
+  int max_passages = 32;        // remembered per mission; the oldest go first
 };
 
-/// A region no route should pass through: a vertical cylinder.
+/// A region no route should pass through: a vertical cylinder round the
+/// column of altitudes in which the gap is too narrow, and a search step
+/// more above and below.
 struct NarrowPassage {
-  Vec3 centre = Vec3::Zero();  // m, world NED: the widest spot of the pinch found
+  Vec3 centre = Vec3::Zero();  // m, world NED: the middle of that column
   double radius = 0;           // m, horizontal: any route through the pinch passes within it
   double half_height = 0;      // m above and below the centre
-  double clearance = 0;        // m, the most the pinch offers (less than required)
+  double clearance = 0;        // m, the most the pinch offers where found (less than required)
 };
 
 /// The first pinch along `route` (world NED, first point where the route
 /// starts) within settings.look_distance of its start: a point at which
 /// no point of the plane across the route within settings.max_shift has
 /// `required` clearance. Found by climbing the clearance gradient within
-/// that plane. A pinch round the route's start is passed over (the
+/// that plane. The pinch's column: every altitude within
+/// settings.max_extent above and below at which the gap, crossed level
+/// within max_shift, is too narrow as well (searched every extent_step).
+/// A pinch round the route's start is passed over (the
 /// vehicle stopped in a narrow spot: routes may leave it). nullopt when
 /// every point can be passed, for an empty query or for fewer than two
 /// points.
@@ -52,7 +59,7 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
 /// The passages found in one mission, for the global planner.
 class PassageMemory {
  public:
-  explicit PassageMemory(int capacity = 16) : capacity_(capacity) {}
+  explicit PassageMemory(int capacity = 32) : capacity_(capacity) {}
   /// Adds `passage` unless its centre lies within a remembered one; drops
   /// the oldest beyond the capacity. True if it was added.
   bool add(const NarrowPassage& passage);
