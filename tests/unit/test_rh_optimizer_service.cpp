@@ -15,6 +15,7 @@
 #include "ofn/common/logging.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
+#include "ofn/common/validate.hpp"
 #include "ofn/rh_optimizer/rh_optimizer_service.hpp"
 #include "service_test_bus.hpp"
 
@@ -138,6 +139,25 @@ TEST_F(RhOptimizerServiceTest, ClearWayAheadLeavesNominalGuidanceAlone) {
   EXPECT_EQ(trajs_.front().mode, ref_traj_t::NOMINAL);
   ASSERT_FALSE(stats_.empty());
   EXPECT_EQ(stats_.back().status, solver_stats_t::NOT_RUN);
+}
+
+TEST_F(RhOptimizerServiceTest, TheMissionsNarrowPassagesGoOutOnceASecond) {
+  std::vector<narrow_passages_t> lists;
+  listener_.subscribe<narrow_passages_t>(channels::kNarrowPassages,
+                                         [&](const narrow_passages_t& m) { lists.push_back(m); });
+  // Nothing before a mission: a list belongs to one.
+  for (int i = 0; i < 12; ++i) step(Vec3(kSpeed * 0.1 * i, 0, -kAltitude), 0, 0);
+  EXPECT_TRUE(lists.empty());
+  send(channels::kMission, mission());
+  for (int i = 12; i < 34; ++i) step(Vec3(kSpeed * 0.1 * i, 0, -kAltitude), 0, 0);
+  // The whole (here empty) list, tagged with the mission, once a second.
+  ASSERT_GE(lists.size(), 2u);
+  ASSERT_LE(lists.size(), 3u);
+  for (const auto& m : lists) {
+    EXPECT_EQ(m.mission_id, mission().mission_id);
+    EXPECT_EQ(m.num_passages, 0);
+    EXPECT_EQ(validate(m), "");
+  }
 }
 
 TEST_F(RhOptimizerServiceTest, AWallAheadEngagesAvoidanceOverIt) {
