@@ -13,6 +13,8 @@
 namespace ofn::rh {
 namespace {
 
+using testing_support::untimed;
+
 const Limits kLimits = testing_support::kBenchmarkLimits;
 constexpr double kAltitude = testing_support::kLegAltitude;
 
@@ -138,7 +140,7 @@ StepInput input_at(const Vec3& position, double time, ClearanceQuery clearance, 
 }
 
 TEST(RhPlannerCommit, APlanWithoutASafeStopIsNotCommitted) {
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   // Open space, but nothing seen beyond 5 m ahead: every forward plan's
   // stop runs into unseen space.
   const StepOutput out =
@@ -163,7 +165,7 @@ TEST(RhPlannerCommit, AfterBrakingAFailureNeverReturnsToTheOldPlan) {
   // ahead of the braked vehicle by then, must not be kept.
   FallbackSettings fallback;
   fallback.cold_retry = false;
-  RhPlanner planner({}, fallback);
+  RhPlanner planner(untimed(), fallback);
   const StepOutput first =
       planner.step(input_at(Vec3(0, 0, -kAltitude), 10.0, wall_at(1000), seen_up_to(1000)));
   ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;

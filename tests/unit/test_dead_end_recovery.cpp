@@ -18,6 +18,7 @@ namespace {
 using testing_support::field_with;
 using testing_support::kBenchmarkLimits;
 using testing_support::kLegAltitude;
+using testing_support::untimed;
 
 // An escape leg: from a hover, to a point `to` (world NED), stopping there,
 // with the forward-speed rule relaxed, as the service poses it.
@@ -40,7 +41,7 @@ StepInput escape_leg(const Vec3& from, const Vec3& to, ClearanceQuery clearance)
 
 TEST(EscapeLeg, ShortLegsFromAHoverAreSolved) {
   for (const double length : {8.0, 15.0, 30.0, 60.0}) {
-    RhPlanner planner;
+    RhPlanner planner(untimed());
     const Vec3 from(50, 0, -kLegAltitude);
     const Vec3 to(50, -length, -kLegAltitude);
     const StepOutput out = planner.step(escape_leg(from, to, field_with({})));
@@ -59,7 +60,7 @@ TEST(EscapeLeg, ShortLegsFromAHoverAreSolved) {
 // speed limit from t = 0, faster than a vehicle at rest can move.
 TEST(EscapeLeg, FromAHoverJustInsideThePlannedClearance) {
   using testing_support::Box;
-  RhSettings settings;
+  RhSettings settings = untimed();
   settings.clearance_margin = 0.5;
   RhPlanner planner(settings);
   // A wall at north 40..43, the vehicle 6.4 m short of it, leaving south.
@@ -110,7 +111,7 @@ TEST(VerticalMove, FromHoverToHoverWithinTheLimits) {
 // flown throughout; from a moving state it brakes first.
 TEST(RhPlannerClimb, FromAHoverBesideAWallTheClimbIsCommittedAndKept) {
   using testing_support::Box;
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   const Vec3 hover(40.5 - kBenchmarkLimits.clearance - 1.0, 0, -kLegAltitude);
   StepInput in = escape_leg(hover, hover, field_with({Box{40, 43, -60, 60, 150.0f}}));
   in.problem.velocity = Vec3::Zero();
@@ -148,7 +149,7 @@ TEST(RhPlannerClimb, AClimbIntoSomethingMappedAboveIsRefusedInTime) {
     d.gradient = Vec3(0, 0, 1);
     return d;
   };
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   const Vec3 hover(0, 0, -(kLegAltitude - 8.0));  // 14 m under the roof
   StepInput in = escape_leg(hover, hover, roof);
   in.problem.velocity = Vec3::Zero();

@@ -16,6 +16,7 @@
 #include "ofn/rh_optimizer/rh_nlp.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 #include "ofn/world/world.hpp"
+#include "rh_step_inputs.hpp"
 
 namespace ofn::rh {
 namespace {
@@ -29,6 +30,7 @@ constexpr double kMapperMargin = 1.5;  // m, horizontal inflation like the mappe
 
 using mapping::DistanceField;
 using mapping::Heightfield;
+using testing_support::untimed;
 
 // The true obstacles rasterised at 1 m: a cell within the margin of an
 // obstacle's footprint gets the obstacle's height.
@@ -226,7 +228,7 @@ TEST(RhNlp, GradientsMatchCentralDifferences) {
 }
 
 TEST(RhNlp, FitReproducesASplineGuessAndItsState) {
-  RhSettings settings;
+  RhSettings settings = untimed();
   RhOptimizer optimizer(settings);
   RhProblem problem;
   problem.frame = GuidanceFrame::from_leg(Vec3(0, 0, -30), Vec3(200, 0, -30));
@@ -259,7 +261,7 @@ RhProblem open_course_problem(const Scenario& open) {
 
 TEST(RhOptimizer, OpenSpaceFromAStraightGuess) {
   const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   RhProblem problem = open_course_problem(open);
   for (const double along : {0.0, 40.0, 90.0}) {
     problem.position = problem.frame.to_world(Vec3(along, 2.0, 0.0));
@@ -278,7 +280,7 @@ TEST(RhOptimizer, AStartAboveTheAccelerationReserveIsBroughtInsideIt) {
   // from its first collocation point on. Taken as it is, a start above the
   // reserve let each plan climb a little higher than the one before.
   const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
-  RhSettings settings;
+  RhSettings settings = untimed();
   settings.accel_margin = 0.06;
   RhOptimizer optimizer(settings);
   RhProblem problem = open_course_problem(open);
@@ -303,7 +305,7 @@ TEST(RhOptimizer, AClimbingLegKeepsTheWorldsVerticalSpeedLimit) {
   // hover to a stop at its end. Its guidance frame is pitched, so its z is
   // not the vertical; the vertical speed limit is the world's.
   const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   RhProblem problem;
   problem.position = Vec3(0.0, 0.0, -30.0);
   problem.target = Vec3(5.0, 0.0, -50.0);
@@ -330,7 +332,7 @@ TEST(RhOptimizer, ASidewaysPlanKeepsItsForwardSpeedReserve) {
   // (|v|^2 + 1 m^2/s^2) once the reserve has built up (1 s), room for the
   // controller's tracking error; a dead-end escape (rule relaxed) does not.
   const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
-  RhSettings settings;
+  RhSettings settings = untimed();
   settings.speed_margin = 0.005;  // the service's reserves
   settings.accel_margin = 0.06;
   settings.forward_speed_reserve = 0.15;
@@ -379,7 +381,7 @@ TEST(RhOptimizer, StopsAtRestOnTheLastWaypoint) {
   // The last waypoint 40 m ahead, the vehicle 3 m beside the leg at cruise
   // speed: the trajectory ends on the waypoint at rest, within the limits.
   const Scenario open = load_scenario(std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml");
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   RhProblem problem = open_course_problem(open);
   problem.terminal_x = problem.frame.to_guidance(problem.target).x();
   problem.position = problem.frame.to_world(Vec3(problem.terminal_x - 40.0, 3.0, 0.0));
@@ -411,7 +413,7 @@ class RhOptimizerCourse : public ::testing::TestWithParam<CourseCase> {};
 TEST_P(RhOptimizerCourse, FeasibleAtEveryStartAndBetweenCollocationPoints) {
   const CourseCase& c = GetParam();
   const Course course = load_course(c.name, c.route_feet);
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   for (const double start_x : c.starts_feet) {
     const Vec3 position = route_at(course.route, start_x * kMetresPerFoot);
     const RhProblem problem = course_problem(course, position);
@@ -428,8 +430,8 @@ TEST_P(RhOptimizerCourse, ScreeningKeepsEveryConstraintAndTheCost) {
   // with and without screening.
   const CourseCase& c = GetParam();
   const Course course = load_course(c.name, c.route_feet);
-  RhOptimizer full;
-  RhSettings settings;
+  RhOptimizer full(untimed());
+  RhSettings settings = untimed();
   settings.screening_margin = 0.5;
   RhOptimizer screened(settings);
   const int all_rows =
@@ -522,7 +524,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(RhOptimizer, SeededRandomFieldsWithAFreeCorridor) {
   const Limits limits{3.048, 0.4877, 1.524, 0.0, 6.096, 60.96};
   const double altitude = 30.0;
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   const double keep_out =
       limits.clearance + optimizer.settings().clearance_margin + kMapperMargin + 4.0;
   for (unsigned seed = 1; seed <= 10; ++seed) {
@@ -584,7 +586,7 @@ TEST(RhOptimizer, WarmStartsTakeFewerIterationsThanColdStarts) {
   const Course course = load_course(
       "bench4",
       {{-100, 0, 120}, {40, 0, 120}, {150, 75, 120}, {250, 75, 120}, {360, 0, 120}, {500, 0, 120}});
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   RhProblem problem = course_problem(course, route_at(course.route, 20 * kMetresPerFoot));
   SolveReport previous =
       optimizer.solve(problem, RhOptimizer::guess_from_path(course.route, problem, 3.048));
@@ -621,7 +623,7 @@ bool all_finite(const SolveReport& report) {
 
 TEST(RhOptimizer, StartInsideAnObstacleNeverGivesNaN) {
   const Course course = load_course("bench4", {{-100, 0, 120}, {500, 0, 120}});
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   const RhProblem problem = course_problem(course, feet(200, 0, 120));  // inside the cube
   ASSERT_LT(problem.clearance(problem.position).distance, 0.0);
   const SolveReport report = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
@@ -650,14 +652,14 @@ TEST(RhOptimizer, TargetBehindAWallNeverGivesNaN) {
   problem.terminal_x = 60.0;
   problem.limits = Limits{3.048, 0.4877, 1.524, 0.0, 6.096, 60.96};
   problem.clearance = query_of(build_field(heightfield));
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   const SolveReport report = optimizer.solve(problem, RhOptimizer::guess_straight(problem));
   EXPECT_FALSE(report.feasible);
   EXPECT_TRUE(all_finite(report)) << report.message;
 }
 
 TEST(RhOptimizer, BadProblemsAreReportedNotThrown) {
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   RhProblem problem;
   problem.frame = GuidanceFrame::from_leg(Vec3(0, 0, -30), Vec3(200, 0, -30));
   problem.position = Vec3(0, 0, -30);
@@ -693,7 +695,7 @@ TEST(RhOptimizer, BadProblemsAreReportedNotThrown) {
 }
 
 TEST(RhOptimizer, RequiredClearanceLetsAStartInsideClimbOut) {
-  RhOptimizer optimizer;
+  RhOptimizer optimizer(untimed());
   RhProblem problem;
   problem.limits = Limits{3.0, 0.5, 1.5, 0.0, 6.0, 60.0};
   const double planned = 6.0 + optimizer.settings().clearance_margin;

@@ -19,6 +19,7 @@ constexpr double kAltitude = testing_support::kLegAltitude;
 
 using testing_support::Box;
 using testing_support::field_with;
+using testing_support::untimed;
 
 StepInput input_at(const Vec3& position, double time, ClearanceQuery clearance) {
   return testing_support::step_input_at(position, time, std::move(clearance));
@@ -40,7 +41,7 @@ bool finite(const BsplineTrajectory& trajectory) {
 }
 
 TEST(RhPlanner, SolvesACleanProblemAndWarmStartsTheNext) {
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   const StepInput first = input_at(Vec3(0, 0, -kAltitude), 10.0, field_with({}));
   const StepOutput out = planner.step(first);
   ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
@@ -105,7 +106,7 @@ TEST(RhPlanner, AShortStopFromAHoverIsSolvedColdAndMovesOffInTime) {
   // that a healthy plan to a stop just beyond it is no longer slow at the
   // look-ahead.
   for (const double distance : {1.0, 2.0, kStallMinDisplacement + 0.1, 5.0}) {
-    RhPlanner planner;
+    RhPlanner planner(untimed());
     StepInput in = input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({}));
     in.problem.velocity = Vec3::Zero();
     in.problem.target = in.problem.position + Vec3(distance, 0, 0);
@@ -126,7 +127,7 @@ TEST(RhPlanner, AShortStopFromAHoverIsSolvedColdAndMovesOffInTime) {
 TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
   // From a hover, the plan moves off at once, so the stall retry stays out
   // of the way: one solve per step.
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   StepInput first = input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({}));
   first.problem.velocity = Vec3::Zero();
   const StepOutput out = planner.step(first);
@@ -141,7 +142,7 @@ TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
 }
 
 TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   const ClearanceQuery open = field_with({});
   const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 5.0, open));
   ASSERT_EQ(first.mode, StepMode::kSolved);
@@ -180,7 +181,7 @@ TEST(RhPlanner, KeepsAStopAtTheWaypointToItsEndButNotAPlanStillMoving) {
 
   // Still at cruise speed where it ends: with 1 s left there is no time for
   // the braking after it, so brake now.
-  RhPlanner passing;
+  RhPlanner passing(untimed());
   const StepOutput moving = passing.step(input_at(Vec3(0, 0, -kAltitude), 0.0, open));
   ASSERT_EQ(moving.mode, StepMode::kSolved) << moving.reason;
   ASSERT_GT(moving.trajectory.velocity(moving.trajectory.duration()).norm(), 1.0);
@@ -202,7 +203,7 @@ TEST(RhPlanner, KeepsAStopAtTheWaypointToItsEndButNotAPlanStillMoving) {
 }
 
 TEST(RhPlanner, KeepsThePreviousWhenTheIterationLimitStopsTheSolve) {
-  RhSettings one_evaluation;
+  RhSettings one_evaluation = untimed();
   one_evaluation.max_iterations = 1;
   RhPlanner planner(one_evaluation);
   // Straight and level at cruise speed: the straight guess is itself feasible.
@@ -222,7 +223,7 @@ TEST(RhPlanner, KeepsThePreviousWhenTheIterationLimitStopsTheSolve) {
 }
 
 TEST(RhPlanner, BrakesWhenTheStartIsInsideTheClearance) {
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   // A tall wall 2 m ahead of the vehicle.
   const ClearanceQuery wall = field_with({{2, 4, -60, 60, 70.0f}});
   const StepInput input = input_at(Vec3(0, 0, -kAltitude), 3.0, wall);
@@ -238,7 +239,7 @@ TEST(RhPlanner, BrakesWhenTheStartIsInsideTheClearance) {
 }
 
 TEST(RhPlanner, BrakesWhenThePreviousRunsIntoANewObstacle) {
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
   ASSERT_EQ(first.mode, StepMode::kSolved);
   // A wall across the whole map, higher than the field, pops up 25 m ahead:
@@ -262,7 +263,7 @@ TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
     // of the wall (RhPlanner.NearerTerminalXWhenNoPlanReachesTheHorizon).
     FallbackSettings fallback;
     fallback.short_retry = false;
-    RhPlanner planner(RhSettings{}, fallback);
+    RhPlanner planner(untimed(), fallback);
     const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
     EXPECT_EQ(first.mode, StepMode::kSolved) << first.reason;
     const int north = static_cast<int>(wall_north);
@@ -290,7 +291,7 @@ TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
 TEST(RhPlanner, PlansToANearerXBeforeItStops) {
   FallbackSettings fallback;
   fallback.short_retry_fraction = 0.3;
-  RhPlanner planner(RhSettings{}, fallback);
+  RhPlanner planner(untimed(), fallback);
   const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
   ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
   StepInput input =
@@ -308,7 +309,7 @@ TEST(RhPlanner, PlansToANearerXBeforeItStops) {
 
 TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
   const FallbackSettings fallback;
-  const RhPlanner planner(RhSettings{}, fallback);
+  const RhPlanner planner(untimed(), fallback);
   const double limit = fallback.braking_accel_fraction * kLimits.max_accel;
   for (const Vec3& velocity :
        {Vec3(3.0, 0, 0), Vec3(1.5, -2.0, 0.8), Vec3(0.05, 0.02, 0), Vec3(0, 0, 0)}) {
@@ -352,7 +353,7 @@ TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
 }
 
 TEST(RhPlanner, NonFiniteInputBrakesWithoutNaN) {
-  RhPlanner planner;
+  RhPlanner planner(untimed());
   StepInput input = input_at(Vec3(0, 0, -kAltitude), 1.0, field_with({}));
   input.problem.velocity.y() = std::nan("");
   const StepOutput out = planner.step(input);
