@@ -13,6 +13,12 @@ constexpr double kMaxStep = 0.5;  // m
 // Spacing of the samples over the cross-section before the ascent.
 constexpr double kSampleSpacing = 0.5;  // m
 
+// Whether `point` lies in the passage's cylinder.
+bool inside(const NarrowPassage& passage, const Vec3& point) {
+  const Vec3 d = point - passage.centre;
+  return std::hypot(d.x(), d.y()) <= passage.radius && std::abs(d.z()) <= passage.half_height;
+}
+
 struct Crossing {
   bool passable = false;
   Vec3 best = Vec3::Zero();
@@ -130,21 +136,15 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
     // A pinch round the route's start (the vehicle, stopped in a narrow
     // spot) cannot be routed round: the planner lets routes leave it. Look
     // for one farther on.
-    const Vec3 from_start = route.front() - passage.centre;
-    if (std::hypot(from_start.x(), from_start.y()) <= passage.radius &&
-        std::abs(from_start.z()) <= passage.half_height)
-      continue;
+    if (inside(passage, route.front())) continue;
     return passage;
   }
   return std::nullopt;
 }
 
 bool PassageMemory::add(const NarrowPassage& passage) {
-  for (const NarrowPassage& known : passages_) {
-    const Vec3 d = passage.centre - known.centre;
-    if (std::hypot(d.x(), d.y()) <= known.radius && std::abs(d.z()) <= known.half_height)
-      return false;
-  }
+  for (const NarrowPassage& known : passages_)
+    if (inside(known, passage.centre)) return false;
   passages_.push_back(passage);
   if (capacity_ > 0 && static_cast<int>(passages_.size()) > capacity_)
     passages_.erase(passages_.begin());
