@@ -49,11 +49,13 @@ exit_if_no_flight() {  # exit_if_no_flight LAUNCHER_STATUS [CONFIG_ERROR]
   fi
 }
 
-report_flight() {  # report_flight BIN OUT SCENARIO LOG; sets report_status
+report_flight() {  # report_flight BIN OUT SCENARIO LOG [KEYRING]; sets report_status
   # The report's exit code is the verdict (1: the flight failed); the figure
-  # is drawn either way, since a failed flight is the one to look at.
+  # is drawn either way, since a failed flight is the one to look at. With
+  # the keyring of an authenticated bus the report reads only what was
+  # signed by a role allowed to, as the services did.
   report_status=0
-  "$1/ofn_flight_report" --log "$4" --scenario "$3" \
+  "$1/ofn_flight_report" --log "$4" --scenario "$3" ${5:+--bus-keys "$5"} \
     --controller-config "$repo/config/controller.yaml" --out "$2" || report_status=$?
   /usr/bin/python3 "$repo/services/tools/plot_flight.py" "$2" >/dev/null &&
     echo "  figures           : $2/flight.png, $2/tracking.png"

@@ -491,7 +491,7 @@ if [[ ! -f "$out/latest_log" ]]; then
 fi
 log=$(cat "$out/latest_log")
 echo
-report_flight "$bin" "$out" "$scenario" "$log"
+report_flight "$bin" "$out" "$scenario" "$log" "${host_keys[gcs]:-}"
 echo "$latency"
 [[ -f "$out/heartbeats.csv" ]] && { bridge_traffic || true; }
 echo "  hosts' logs       : $(dirname "$log")/$(basename "$log" .lcm)/ (gcs), $out/onboard1/, $out/onboard2/"

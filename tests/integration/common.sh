@@ -10,7 +10,7 @@ if [[ -z "${OFN_IN_NETNS:-}" ]]; then
   exec "$REPO/deploy/netns.sh" "$0" "$@"
 fi
 WORK=$(mktemp -d /tmp/ofn-it.XXXXXX)
-trap 'rm -rf "$WORK"' EXIT
+[[ -n ${OFN_KEEP_WORK:-} ]] || trap 'rm -rf "$WORK"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 pass() { echo "PASS: $*"; }
 # Named network namespaces need root (a user namespace cannot make them):

@@ -69,6 +69,14 @@ outcome=$(/usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1
 [[ $outcome == success ]] || { grep -A6 "^Flight " "$WORK/fly.txt" || true
   fail "three hosts: outcome $outcome (exit code $status)"; }
 [[ $status == 0 ]] || fail "outcome success but exit code $status"
+# The report read the recording with the ground station's keyring: the
+# stranger's messages in it were left out, as the services left them out.
+skipped=$(/usr/bin/python3 -c 'import json, sys
+print(json.load(open(sys.argv[1]))["messages_skipped"]["unauthenticated"])' "$WORK/run/summary.json")
+[[ $skipped =~ ^[0-9]+$ && $skipped -gt 0 ]] ||
+  fail "the report did not authenticate the recording (unauthenticated skipped: $skipped)"
+grep -q "^  bus               : authenticated; read only what the keyring's roles signed" \
+  "$WORK/fly.txt" || fail "no 'bus : authenticated' line in the report"
 
 # The recording is made on gcs alone; everything from onboard1 and onboard2
 # in it crossed the bridge.

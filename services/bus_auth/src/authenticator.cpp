@@ -192,32 +192,38 @@ std::vector<std::string> PublishPolicy::roles() const {
   return roles;
 }
 
+Verifier::Verifier(std::map<std::string, PublicKey> public_keys, PublishPolicy policy,
+                   std::function<int64_t()> wall_now_us, double freshness)
+    : public_keys_(std::move(public_keys)),
+      policy_(std::move(policy)),
+      wall_now_us_(std::move(wall_now_us)),
+      freshness_us_(static_cast<int64_t>(std::llround(freshness * 1e6))) {
+  init_sodium();
+  if (!(freshness > 0) || !std::isfinite(freshness))
+    throw KeyError("freshness must be a positive number of seconds");
+  if (!wall_now_us_) throw KeyError("no wall clock given");
+}
+
 Authenticator::Authenticator(std::string role, const SecretKey& secret_key,
                              std::map<std::string, PublicKey> public_keys, PublishPolicy policy,
                              std::function<int64_t()> wall_now_us, double freshness)
     : role_(std::move(role)),
       secret_key_(secret_key),
-      public_keys_(std::move(public_keys)),
-      policy_(std::move(policy)),
-      wall_now_us_(std::move(wall_now_us)),
-      freshness_us_(static_cast<int64_t>(std::llround(freshness * 1e6))) {
-  init_sodium();
+      wall_now_us_(wall_now_us),
+      verifier_(std::move(public_keys), std::move(policy), std::move(wall_now_us), freshness) {
   if (!valid_role(role_))
     throw KeyError("role '" + role_ + "' must be 1-16 letters, digits, '_' or '-'");
-  if (!(freshness > 0) || !std::isfinite(freshness))
-    throw KeyError("freshness must be a positive number of seconds");
-  if (!wall_now_us_) throw KeyError("no wall clock given");
   // The secret key holds its public half: it must be the one the others
   // check against, or everything this host says would be refused.
-  const auto own = public_keys_.find(role_);
-  if (own == public_keys_.end())
+  const auto own = verifier_.public_keys().find(role_);
+  if (own == verifier_.public_keys().end())
     throw KeyError("the keyring holds no public key of role '" + role_ + "'");
   if (std::memcmp(own->second.data(), secret_key_.data() + 32, kPublicKeyBytes) != 0)
     throw KeyError("the secret key of role '" + role_ + "' does not belong to its public key");
 }
 
 void Authenticator::seal(const std::string& channel, std::vector<uint8_t>& message) {
-  if (!policy_.may_publish(role_, channel))
+  if (!may_publish(channel))
     throw KeyError("role '" + role_ + "' may not publish on " + channel +
                    " (the keyring's policy.yaml)");
   // Sequences are wall-clock microseconds, kept strictly increasing, so a
@@ -236,7 +242,7 @@ void Authenticator::seal(const std::string& channel, std::vector<uint8_t>& messa
   message.insert(message.end(), kTrailerMagic.begin(), kTrailerMagic.end());
 }
 
-Opened Authenticator::open(const std::string& channel, const void* data, size_t size) {
+Opened Verifier::open(const std::string& channel, const void* data, size_t size) {
   Opened result;
   if (!ends_with_trailer(data, size)) {
     result.reason = "not signed";
@@ -282,24 +288,43 @@ Opened Authenticator::open(const std::string& channel, const void* data, size_t 
   return result;
 }
 
+namespace {
+
+/// The keyring's policy and the public keys of all its roles.
+std::pair<PublishPolicy, std::map<std::string, PublicKey>> load_public_half(
+    const std::string& dir) {
+  auto policy = PublishPolicy::load(dir + "policy.yaml");
+  std::map<std::string, PublicKey> public_keys;
+  for (const auto& r : policy.roles()) public_keys[r] = read_public_key(dir + r + ".pub");
+  return {std::move(policy), std::move(public_keys)};
+}
+
+std::string as_directory(const std::string& keyring_dir) {
+  return keyring_dir.empty() || keyring_dir.back() == '/' ? keyring_dir : keyring_dir + "/";
+}
+
+}  // namespace
+
 Authenticator load_authenticator(const std::string& keyring_dir, const std::string& role,
                                  std::function<int64_t()> wall_now_us) {
   if (!valid_role(role))
     throw KeyError("--bus-role '" + role + "' must be 1-16 letters, digits, '_' or '-'");
-  const std::string dir =
-      keyring_dir.empty() || keyring_dir.back() == '/' ? keyring_dir : keyring_dir + "/";
-  auto policy = PublishPolicy::load(dir + "policy.yaml");
+  const std::string dir = as_directory(keyring_dir);
+  auto [policy, public_keys] = load_public_half(dir);
   const auto roles = policy.roles();
   if (std::find(roles.begin(), roles.end(), role) == roles.end()) {
     std::string known;
     for (const auto& r : roles) known += (known.empty() ? "" : ", ") + r;
     throw KeyError("role '" + role + "' is not in " + dir + "policy.yaml (roles: " + known + ")");
   }
-  std::map<std::string, PublicKey> public_keys;
-  for (const auto& r : roles) public_keys[r] = read_public_key(dir + r + ".pub");
   const auto secret = read_secret_key(dir + role + ".key");
   return Authenticator(role, secret, std::move(public_keys), std::move(policy),
                        std::move(wall_now_us));
+}
+
+Verifier load_verifier(const std::string& keyring_dir, std::function<int64_t()> wall_now_us) {
+  auto [policy, public_keys] = load_public_half(as_directory(keyring_dir));
+  return Verifier(std::move(public_keys), std::move(policy), std::move(wall_now_us));
 }
 
 }  // namespace ofn::bus_auth

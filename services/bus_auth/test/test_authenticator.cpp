@@ -276,6 +276,35 @@ TEST_F(Keyring, LoadsAndTwoRolesTalk) {
   EXPECT_EQ(info.st_mode & 0777, 0600u);
 }
 
+// A reader of a recording holds no secret key: the keyring's public half
+// checks what each role signed, and refuses the same as a host does.
+TEST_F(Keyring, AVerifierNeedsOnlyThePublicHalf) {
+  auto a = load_authenticator(dir_.string(), "a", now);
+  auto b = load_authenticator(dir_.string(), "b", now);
+  std::filesystem::remove(path("a.key"));
+  std::filesystem::remove(path("b.key"));
+  auto verifier = load_verifier(dir_.string(), now);
+  auto on_x = payload(10), on_y = payload(10);
+  a.seal("X", on_x);
+  b.seal("Y", on_y);
+  EXPECT_TRUE(verifier.open("X", on_x.data(), on_x.size()).authentic);
+  EXPECT_TRUE(verifier.open("Y", on_y.data(), on_y.size()).authentic);
+  EXPECT_EQ(verifier.open("X", on_x.data(), on_x.size()).reason,
+            "replayed (sequence not newer than the last accepted)");
+  auto forged = payload(10);
+  a.seal("X", forged);
+  EXPECT_EQ(verifier.open("Y", forged.data(), forged.size()).reason,
+            "role 'a' may not publish here");
+  forged[0] ^= 1;
+  EXPECT_EQ(verifier.open("X", forged.data(), forged.size()).reason,
+            "bad signature (altered, or signed with another key)");
+  const auto unsigned_message = payload(10);
+  EXPECT_EQ(verifier.open("X", unsigned_message.data(), unsigned_message.size()).reason,
+            "not signed");
+  std::filesystem::remove(path("b.pub"));
+  EXPECT_THROW(load_verifier(dir_.string(), now), KeyError);
+}
+
 TEST_F(Keyring, SayWhatIsWrong) {
   const auto message_of = [&](const std::string& role) -> std::string {
     try {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ofn/actuator_cmd_t.hpp"
+#include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/bus_auth/trailer.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
@@ -232,8 +233,14 @@ class LogDecoder {
   LogDecoder(FlightRecord& record, CsvTables& tables, Utime t0)
       : record_(record), tables_(tables), t0_(t0) {}
 
-  /// False when the message does not decode.
-  bool handle(const std::string& channel, const lcm::LogEvent& e) {
+  /// What became of a logged message.
+  enum class Outcome { kRead, kUndecodable, kInvalid };
+
+  /// Reads one message. One that fails the validation the services apply
+  /// (a stranger's NaN position, say) is left out of the record and the
+  /// tables, as the services left it out of the flight.
+  Outcome handle(const std::string& channel, const lcm::LogEvent& e) {
+    rejection_.clear();
     if (channel == channels::kNavState) return on<nav_state_t>(e, [this](auto& m) { nav(m); });
     if (channel == channels::kControlStatus)
       return on<control_status_t>(e, [this](auto& m) { control_status(m); });
@@ -251,13 +258,12 @@ class LogDecoder {
       return on<global_path_t>(e,
                                [this](auto& m) { tables_.path(rel(m.utime), record_.paths++, m); });
     if (channel == channels::kNarrowPassages)
-      return on<narrow_passages_t>(e, [this](auto& m) {
-        if (validate(m).empty()) record_.narrow_passages = m.num_passages;
-      });
+      return on<narrow_passages_t>(e,
+                                   [this](auto& m) { record_.narrow_passages = m.num_passages; });
     if (channel == channels::kRefTraj)
       return on<ref_traj_t>(e, [this](auto& m) {
         // A plan sent as its spline alone is tabled as its receivers sample it.
-        if (validate(m).empty()) expand_ref_traj(m);
+        expand_ref_traj(m);
         tables_.ref_traj(rel(m.utime), rel(m.t0_utime), m);
       });
     if (channel == channels::kSolverStats)
@@ -269,18 +275,23 @@ class LogDecoder {
       return on<mission_t>(e, [this](auto& m) { record_.mission = m; });
     if (channel.rfind(channels::kHeartbeatPrefix, 0) == 0)
       return on<heartbeat_t>(e, [this](auto& m) { tables_.heartbeat(rel(m.utime), m); });
-    return true;  // a channel the report does not read
+    return Outcome::kRead;  // a channel the report does not read
   }
+
+  /// Why the last message handled was invalid.
+  const std::string& rejection() const { return rejection_; }
 
  private:
   double rel(Utime t) const { return to_seconds(t - t0_); }
 
   template <class Msg, class Use>
-  static bool on(const lcm::LogEvent& e, Use use) {
+  Outcome on(const lcm::LogEvent& e, Use use) {
     Msg m{};
-    if (!decode(e, m)) return false;
+    if (!decode(e, m)) return Outcome::kUndecodable;
+    rejection_ = validate(m);
+    if (!rejection_.empty()) return Outcome::kInvalid;
     use(m);
-    return true;
+    return Outcome::kRead;
   }
 
   void nav(const nav_state_t& m) {
@@ -339,22 +350,68 @@ class LogDecoder {
   FlightRecord& record_;
   CsvTables& tables_;
   Utime t0_;
+  std::string rejection_;
+};
+
+/// Counts what `handle` made of a message in `result`.
+void count(LogDecoder& decoder, const lcm::LogEvent& e, ReportResult& result) {
+  switch (decoder.handle(e.channel, e)) {
+    case LogDecoder::Outcome::kRead:
+      break;
+    case LogDecoder::Outcome::kUndecodable:
+      ++result.undecodable;
+      break;
+    case LogDecoder::Outcome::kInvalid:
+      if (result.invalid++ == 0) result.first_invalid = e.channel + ": " + decoder.rejection();
+      break;
+  }
+}
+
+/// Checks each message of a recording of an authenticated bus as its
+/// receivers did, at the (wall) time it was recorded: a stranger's message
+/// in the recording is not the flight's.
+class RecordingVerifier {
+ public:
+  explicit RecordingVerifier(const std::string& keyring_dir)
+      : verifier_(bus_auth::load_verifier(keyring_dir, [this] { return recorded_at_; })) {}
+  RecordingVerifier(const RecordingVerifier&) = delete;
+  RecordingVerifier& operator=(const RecordingVerifier&) = delete;
+
+  bus_auth::Opened open(const lcm::LogEvent& e) {
+    recorded_at_ = e.timestamp;
+    return verifier_.open(e.channel, e.data, e.datalen > 0 ? static_cast<size_t>(e.datalen) : 0);
+  }
+
+ private:
+  int64_t recorded_at_ = 0;
+  bus_auth::Verifier verifier_;
 };
 
 /// Reads the log (opened from `log_path`) into `record` and the tables.
 /// Events before the first navigation sample have no time base yet; they
 /// are kept until it comes.
-void read_log(lcm::LogFile& log, const std::string& log_path, FlightRecord& record,
-              CsvTables& tables, ReportResult& result) {
+/// With `verifier`, only authentic messages are read.
+void read_log(lcm::LogFile& log, const std::string& log_path, RecordingVerifier* verifier,
+              FlightRecord& record, CsvTables& tables, ReportResult& result) {
   std::optional<LogDecoder> decoder;
   std::vector<lcm::LogEvent> held;
   std::vector<std::vector<uint8_t>> held_data;
   while (const lcm::LogEvent* e = log.readNextEvent()) {
     ++result.events;
+    // LCM's self-test, sent unsigned by every process as it starts, is
+    // not a message of the flight's.
+    if (verifier && e->channel != "LCM_SELF_TEST") {
+      const bus_auth::Opened opened = verifier->open(*e);
+      if (!opened.authentic) {
+        if (result.unauthenticated++ == 0)
+          result.first_unauthenticated = e->channel + ": " + opened.reason;
+        continue;
+      }
+    }
     if (!decoder) {
       if (e->channel == channels::kNavState) {
         nav_state_t m{};
-        if (decode(*e, m)) decoder.emplace(record, tables, m.utime);
+        if (decode(*e, m) && validate(m).empty()) decoder.emplace(record, tables, m.utime);
       }
       if (!decoder) {
         held.push_back(*e);
@@ -364,15 +421,15 @@ void read_log(lcm::LogFile& log, const std::string& log_path, FlightRecord& reco
       }
       for (size_t i = 0; i < held.size(); ++i) {
         held[i].data = held_data[i].data();
-        if (!decoder->handle(held[i].channel, held[i])) ++result.undecodable;
+        count(*decoder, held[i], result);
       }
       held.clear();
     }
-    if (!decoder->handle(e->channel, *e)) ++result.undecodable;
+    count(*decoder, *e, result);
   }
   // Bad input (exit code 2), like an unreadable log.
   if (record.nav.empty())
-    throw std::invalid_argument(log_path + ": no NAV_STATE messages in the log");
+    throw std::invalid_argument(log_path + ": no valid NAV_STATE messages in the log");
   // A multi-process log holds messages in arrival order.
   std::sort(record.map_stamps.begin(), record.map_stamps.end());
   std::sort(record.plan_steps.begin(), record.plan_steps.end(),
@@ -412,6 +469,11 @@ nlohmann::ordered_json summary_json(const FlightRecord& record, const Judged& j,
   json["gate_finish_t"] = json_number(s.gate_finish_time);
   json["gate_to_gate"] = json_number(s.gate_to_gate);
   json["reached_last_waypoint"] = s.reached_last_waypoint;
+  // What the report left out of the flight, and why.
+  json["messages_skipped"] = {
+      {"undecodable", result.undecodable},
+      {"invalid", result.invalid},
+      {"unauthenticated", result.authenticated ? Json(result.unauthenticated) : Json(nullptr)}};
   json["crossed_finish"] = s.crossed_finish;
   json["duration"] = s.duration;
   json["max_speed"] = s.max_speed;
@@ -556,6 +618,14 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
   if (record.paths > 0) t << "  global planner    : " << record.paths << " paths published\n";
   if (result.undecodable)
     t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
+  if (result.authenticated)
+    t << "  bus               : authenticated; read only what the keyring's roles signed on "
+      << "their channels (" << result.unauthenticated << " other messages skipped"
+      << (result.unauthenticated ? ", the first " + result.first_unauthenticated : "") << ")\n";
+  if (result.invalid)
+    t << "  warning           : " << result.invalid
+      << " invalid messages skipped, as the services skip them (first: " << result.first_invalid
+      << ")\n";
   t << "  files             : " << out.string() << "/{nav_state,control_status,actuator_cmd,"
     << "heartbeats,waypoints,scan_points,cuboids,global_path,ref_traj,solver_stats}.csv, "
     << "summary.json\n";
@@ -566,19 +636,23 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
 
 ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
                                  const std::optional<Scenario>& scenario,
-                                 const PseudoControlBound& pseudo_control_bound) {
+                                 const PseudoControlBound& pseudo_control_bound,
+                                 const std::string& bus_keyring) {
   namespace fs = std::filesystem;
   // Checked before any folder or file is made.
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::invalid_argument("cannot read LCM log " + log_path);
+  std::optional<RecordingVerifier> verifier;
+  if (!bus_keyring.empty()) verifier.emplace(bus_keyring);
   const fs::path out(out_dir);
   fs::create_directories(out);
 
   ReportResult result;
+  result.authenticated = verifier.has_value();
   FlightRecord record;
   {
     CsvTables tables(out);
-    read_log(log, log_path, record, tables, result);
+    read_log(log, log_path, verifier ? &*verifier : nullptr, record, tables, result);
   }
   CsvTables::waypoints(out, record.mission);
   CsvTables::cuboids(out, record);

@@ -13,7 +13,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"ofn flight report: turns an LCM flight log into CSV files and a summary"};
-  std::string log_path, out_dir, scenario_path, controller_config_path;
+  std::string log_path, out_dir, scenario_path, controller_config_path, bus_keys;
   app.add_option("--log", log_path, "LCM log file (lcm-logger output)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -25,6 +25,10 @@ int main(int argc, char** argv) {
                  "the controller's config the flight was flown with, for the bound of its "
                  "pseudo-control (default: the controller's defaults)")
       ->check(CLI::ExistingFile);
+  app.add_option("--bus-keys", bus_keys,
+                 "keyring of the authenticated bus the log was recorded on (its policy.yaml "
+                 "and public keys): read only what its roles signed on their channels")
+      ->check(CLI::ExistingDirectory);
   app.footer(
       "Exit code: 0 when the flight's outcome is success or safe_stop, 1 when it is "
       "failure, 2 for bad arguments or an unreadable log.");
@@ -39,7 +43,8 @@ int main(int argc, char** argv) {
     const auto controller = ofn::control::load_controller_config(controller_reader);
     const ofn::report::PseudoControlBound bound{controller.gains.max_horizontal_accel,
                                                 controller.gains.max_vertical_accel};
-    const auto result = ofn::report::write_flight_report(log_path, out_dir, scenario, bound);
+    const auto result =
+        ofn::report::write_flight_report(log_path, out_dir, scenario, bound, bus_keys);
     std::cout << result.text;
     return result.verdict.outcome == ofn::report::Outcome::kFailure ? 1 : 0;
   });

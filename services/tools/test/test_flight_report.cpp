@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
+#include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/scenario.hpp"
@@ -203,6 +206,132 @@ TEST_F(FlightReport, NamesWithQuotesStayJson) {
   EXPECT_EQ(json.at("log"), log);
 }
 
+// A stranger's NAV_STATE in the recording (a bus fuzz's: north not a
+// number, down 0 m, stamped 0) is not the vehicle's: it is left out, counted
+// and named, and it does not put the vehicle on the ground.
+TEST_F(FlightReport, InvalidMessagesAreLeftOutAndCounted) {
+  const Scenario open = load_scenario(kOpenScenario);
+  const std::string path = hover_log("hover.lcm", open.start_position, 1.0);
+  {
+    lcm::LogFile log(path, "a");
+    ASSERT_TRUE(log.good());
+    nav_state_t forged{};
+    forged.frame = "NED";
+    forged.position[0] = std::numeric_limits<double>::quiet_NaN();
+    forged.position[2] = 0.0;
+    forged.quaternion[0] = 1.0;
+    for (int i = 0; i < 3; ++i) write(log, channels::kNavState, forged, 1001 * kMicrosPerSecond);
+  }
+  const ReportResult clean =
+      write_flight_report(hover_log("clean.lcm", open.start_position, 1.0),
+                          (dir_ / "clean").string(), open, PseudoControlBound{});
+  const ReportResult result =
+      write_flight_report(path, (dir_ / "report").string(), open, PseudoControlBound{});
+  EXPECT_EQ(result.invalid, 3u);
+  EXPECT_EQ(clean.invalid, 0u);
+  EXPECT_EQ(result.first_invalid.rfind("NAV_STATE: position not finite", 0), 0u)
+      << result.first_invalid;
+  EXPECT_NE(result.text.find("3 invalid messages skipped"), std::string::npos) << result.text;
+  ASSERT_TRUE(result.min_clearance && clean.min_clearance);
+  EXPECT_DOUBLE_EQ(*result.min_clearance, *clean.min_clearance);
+  EXPECT_GT(*result.min_clearance, 20.0);
+  EXPECT_EQ(lines_of(dir_ / "report" / "nav_state.csv"), 1u + 101u);
+}
+
+// A recording of an authenticated bus read with its keyring: a DONE signed
+// with the ground station's key (which may not publish CONTROL_STATUS) and
+// unsigned navigation are a stranger's, left out, so the hover is not taken
+// for a finished mission. Without the keyring the forged DONE counts.
+TEST_F(FlightReport, WithTheKeyringOnlyWhatTheRolesSignedIsRead) {
+  namespace auth = bus_auth;
+  const fs::path keys = dir_ / "keyring";
+  fs::create_directories(keys);
+  std::ofstream(keys / "policy.yaml")
+      << "publishers:\n  onboard1: [NAV_STATE, CONTROL_STATUS]\n  gcs: [MISSION]\n";
+  std::map<std::string, auth::KeyPair> pairs;
+  std::map<std::string, auth::PublicKey> public_keys;
+  for (const char* role : {"onboard1", "gcs"}) {
+    pairs[role] = auth::generate_key_pair();
+    public_keys[role] = pairs[role].public_key;
+    auth::write_public_key((keys / (std::string(role) + ".pub")).string(), pairs[role].public_key);
+  }
+  Utime wall = 1'800'000'000'000'000;  // the recording host's clock
+  const auto policy = auth::PublishPolicy::load((keys / "policy.yaml").string());
+  auth::Authenticator onboard1("onboard1", pairs["onboard1"].secret_key, public_keys, policy,
+                               [&wall] { return wall; });
+  // The stranger's own signer signs anything with the ground station's key.
+  auto anything = policy;
+  anything.allow("gcs", "*");
+  auth::Authenticator stranger("gcs", pairs["gcs"].secret_key, public_keys, anything,
+                               [&wall] { return wall; });
+  const auto record = [&](lcm::LogFile& log, auth::Authenticator* signer,
+                          const std::string& channel, const auto& m) {
+    std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    if (signer) signer->seal(channel, bytes);
+    lcm::LogEvent e{};
+    e.timestamp = wall;
+    e.channel = channel;
+    e.datalen = static_cast<int32_t>(bytes.size());
+    e.data = bytes.data();
+    log.writeEvent(&e);
+  };
+  const Scenario open = load_scenario(kOpenScenario);
+  const std::string path = (dir_ / "signed.lcm").string();
+  {
+    lcm::LogFile log(path, "w");
+    ASSERT_TRUE(log.good());
+    for (int i = 0; i <= 100; ++i, wall += 10000) {
+      nav_state_t nav{};
+      nav.utime = i * 10000;
+      nav.frame = "NED";
+      for (int k = 0; k < 3; ++k) nav.position[k] = open.start_position[k];
+      nav.quaternion[0] = 1.0;
+      record(log, &onboard1, channels::kNavState, nav);
+      control_status_t status{};
+      status.utime = nav.utime;
+      status.mode = control_status_t::HOLD;
+      status.mission_id = -1;
+      status.active_waypoint = -1;
+      for (int k = 0; k < 3; ++k) status.ref_position[k] = open.start_position[k];
+      record(log, &onboard1, channels::kControlStatus, status);
+      if (i == 50) {
+        status.mode = control_status_t::DONE;
+        status.mission_id = 1;
+        record(log, &stranger, channels::kControlStatus, status);
+        nav.position[2] = 0.0;  // on the ground, unsigned
+        record(log, nullptr, channels::kNavState, nav);
+      }
+    }
+  }
+  const ReportResult trusting =
+      write_flight_report(path, (dir_ / "trusting").string(), open, PseudoControlBound{});
+  EXPECT_TRUE(trusting.summary.reached_last_waypoint);
+  EXPECT_FALSE(trusting.authenticated);
+
+  const ReportResult result = write_flight_report(path, (dir_ / "report").string(), open,
+                                                  PseudoControlBound{}, keys.string());
+  EXPECT_TRUE(result.authenticated);
+  EXPECT_FALSE(result.summary.reached_last_waypoint);
+  EXPECT_EQ(result.unauthenticated, 2u);
+  EXPECT_EQ(result.first_unauthenticated, "CONTROL_STATUS: role 'gcs' may not publish here");
+  ASSERT_TRUE(result.min_clearance);
+  EXPECT_GT(*result.min_clearance, 20.0);
+  EXPECT_EQ(lines_of(dir_ / "report" / "nav_state.csv"), 1u + 101u);
+  EXPECT_NE(result.text.find("bus               : authenticated"), std::string::npos)
+      << result.text;
+  const nlohmann::json json = read_json(dir_ / "report" / "summary.json");
+  EXPECT_EQ(json.at("messages_skipped").at("unauthenticated"), 2);
+  EXPECT_TRUE(read_json(dir_ / "trusting" / "summary.json")
+                  .at("messages_skipped")
+                  .at("unauthenticated")
+                  .is_null());
+  // A keyring that cannot be read is bad input.
+  EXPECT_THROW(write_flight_report(path, (dir_ / "out").string(), open, PseudoControlBound{},
+                                   (dir_ / "no-keyring").string()),
+               std::invalid_argument);
+}
+
 TEST_F(FlightReport, ALogWithoutNavigationIsBadInput) {
   const std::string path = (dir_ / "empty.lcm").string();
   {
@@ -210,6 +339,18 @@ TEST_F(FlightReport, ALogWithoutNavigationIsBadInput) {
     ASSERT_TRUE(log.good());
   }
   EXPECT_THROW(write_flight_report(path, (dir_ / "out").string(), std::nullopt, {}),
+               std::invalid_argument);
+  // Nothing but a stranger's navigation is no navigation.
+  const std::string forged_path = (dir_ / "forged.lcm").string();
+  {
+    lcm::LogFile log(forged_path, "w");
+    ASSERT_TRUE(log.good());
+    nav_state_t forged{};
+    forged.frame = "NED";
+    forged.quaternion[0] = 2.0;
+    write(log, channels::kNavState, forged, 0);
+  }
+  EXPECT_THROW(write_flight_report(forged_path, (dir_ / "out").string(), std::nullopt, {}),
                std::invalid_argument);
   EXPECT_THROW(write_flight_report((dir_ / "missing.lcm").string(), (dir_ / "out").string(),
                                    std::nullopt, {}),

@@ -82,38 +82,64 @@ struct Opened {
   std::string reason;
 };
 
-class Authenticator {
+/// Checks received messages against the roles' public keys and the
+/// publish policy. Holds no secret key: a host's receiving half, and all a
+/// reader of a recording needs.
+class Verifier {
  public:
-  /// Signs as `role` with `secret_key`; accepts what the roles of
-  /// `public_keys` sign on the channels `policy` gives them, stamped within
-  /// `freshness` seconds of `wall_now_us()` (microseconds since the epoch;
-  /// the hosts' clocks must agree that closely).
-  Authenticator(std::string role, const SecretKey& secret_key,
-                std::map<std::string, PublicKey> public_keys, PublishPolicy policy,
-                std::function<int64_t()> wall_now_us, double freshness = 2.0);
+  /// Accepts what the roles of `public_keys` sign on the channels `policy`
+  /// gives them, stamped within `freshness` seconds of `wall_now_us()`
+  /// (microseconds since the epoch; the hosts' clocks must agree that
+  /// closely).
+  Verifier(std::map<std::string, PublicKey> public_keys, PublishPolicy policy,
+           std::function<int64_t()> wall_now_us, double freshness = 2.0);
 
-  const std::string& role() const { return role_; }
-  /// Whether the policy lets this role publish on `channel`.
-  bool may_publish(const std::string& channel) const { return policy_.may_publish(role_, channel); }
-
-  /// Appends the trailer to `message` (an encoded LCM payload) for
-  /// publication on `channel`. Throws KeyError when the policy does not let
-  /// this role publish there: a misconfigured deployment, found at once.
-  void seal(const std::string& channel, std::vector<uint8_t>& message);
+  const PublishPolicy& policy() const { return policy_; }
+  const std::map<std::string, PublicKey>& public_keys() const { return public_keys_; }
 
   /// Checks a received message. The replay record is updated only for an
   /// authentic one.
   Opened open(const std::string& channel, const void* data, size_t size);
 
  private:
-  std::string role_;
-  SecretKey secret_key_;
   std::map<std::string, PublicKey> public_keys_;
   PublishPolicy policy_;
   std::function<int64_t()> wall_now_us_;
   int64_t freshness_us_;
-  uint64_t last_sent_ = 0;
   std::map<std::pair<std::string, std::string>, uint64_t> last_accepted_;
+  std::vector<uint8_t> scratch_;
+};
+
+class Authenticator {
+ public:
+  /// Signs as `role` with `secret_key`; checks what it receives as a
+  /// Verifier of the same arguments does.
+  Authenticator(std::string role, const SecretKey& secret_key,
+                std::map<std::string, PublicKey> public_keys, PublishPolicy policy,
+                std::function<int64_t()> wall_now_us, double freshness = 2.0);
+
+  const std::string& role() const { return role_; }
+  /// Whether the policy lets this role publish on `channel`.
+  bool may_publish(const std::string& channel) const {
+    return verifier_.policy().may_publish(role_, channel);
+  }
+
+  /// Appends the trailer to `message` (an encoded LCM payload) for
+  /// publication on `channel`. Throws KeyError when the policy does not let
+  /// this role publish there: a misconfigured deployment, found at once.
+  void seal(const std::string& channel, std::vector<uint8_t>& message);
+
+  /// Checks a received message (Verifier::open).
+  Opened open(const std::string& channel, const void* data, size_t size) {
+    return verifier_.open(channel, data, size);
+  }
+
+ private:
+  std::string role_;
+  SecretKey secret_key_;
+  std::function<int64_t()> wall_now_us_;
+  Verifier verifier_;
+  uint64_t last_sent_ = 0;
   std::vector<uint8_t> scratch_;
 };
 
@@ -123,5 +149,10 @@ class Authenticator {
 /// own). Throws KeyError naming what is missing or wrong.
 Authenticator load_authenticator(const std::string& keyring_dir, const std::string& role,
                                  std::function<int64_t()> wall_now_us);
+
+/// A Verifier of a keyring directory's policy.yaml and public keys: what
+/// the reader of a recording of that bus checks it with. Throws KeyError
+/// naming what is missing or wrong.
+Verifier load_verifier(const std::string& keyring_dir, std::function<int64_t()> wall_now_us);
 
 }  // namespace ofn::bus_auth

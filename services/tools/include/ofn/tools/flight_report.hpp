@@ -17,6 +17,17 @@ struct ReportResult {
   std::string text;  // one-screen summary for the terminal
   size_t events = 0;
   size_t undecodable = 0;
+  /// Messages that decoded but failed the services' validation (a stranger
+  /// on the bus, say), left out of the summary and the tables; the first
+  /// one's channel and reason.
+  size_t invalid = 0;
+  std::string first_invalid;
+  /// Whether the log was read with a keyring; the messages not signed by a
+  /// role allowed to publish on their channel, left out; the first one's
+  /// channel and reason.
+  bool authenticated = false;
+  size_t unauthenticated = 0;
+  std::string first_unauthenticated;
   /// Least distance from the flown path to a real surface, the obstacles
   /// and the ground (m); none without a scenario.
   std::optional<double> min_clearance;
@@ -27,9 +38,13 @@ struct ReportResult {
 /// needed). `scenario`, if given, supplies the timing gates, the true world
 /// and the display unit; limits come from the logged MISSION;
 /// `pseudo_control_bound` is the bound of the controller that flew.
-/// Throws std::runtime_error if the log cannot be read.
+/// `bus_keyring`, if given, is a keyring directory of the authenticated bus
+/// the log was recorded on (its policy.yaml and public keys): only what its
+/// roles signed on their channels is read. Throws std::invalid_argument if
+/// the log or the keyring cannot be read.
 ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
                                  const std::optional<Scenario>& scenario,
-                                 const PseudoControlBound& pseudo_control_bound);
+                                 const PseudoControlBound& pseudo_control_bound,
+                                 const std::string& bus_keyring = "");
 
 }  // namespace ofn::report
