@@ -33,7 +33,7 @@ expect_error "field 'nominal_airframe.rotor_radius'" "$BIN/ofn_controller" --con
 expect_error "File does not exist" "$BIN/ofn_controller" --config "$WORK/missing.yaml"
 printf 'not: [valid' > "$WORK/broken.yaml"
 expect_error "broken.yaml: line" "$BIN/ofn_sim_runner" --scenario "$WORK/broken.yaml"
-expect_error "no NAV_STATE\|cannot read" "$BIN/ofn_flight_report" --log "$WORK/ctl.yaml" --out "$WORK/r"
+expect_error "no valid NAV_STATE\|cannot read" "$BIN/ofn_flight_report" --log "$WORK/ctl.yaml" --out "$WORK/r"
 # The authenticated bus: a keyring that cannot be used is an input error
 # naming the file or the role, before the service joins the bus.
 "$BIN/ofn_bus_keygen" --policy "$REPO/config/bus_policy.yaml" --out "$WORK/keys" > /dev/null ||
