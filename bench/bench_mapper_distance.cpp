@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 
 namespace {
 

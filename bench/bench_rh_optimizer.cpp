@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "ofn/common/scenario.hpp"
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 #include "ofn/world/world.hpp"

@@ -18,9 +18,9 @@ unset DESTDIR PYTHONPATH
 env -u DESTDIR cmake --install "$BUILD" --prefix "$PREFIX" > "$WORK/install.txt" 2>&1 ||
   { cat "$WORK/install.txt"; fail "cmake --install failed"; }
 for f in lib/libofn_common.a lib/libofn_bspline.a lib/libofn_bus_auth.a lib/libofn_world.a lib/libofn_rotorcraft_model.a lib/libofn_vehicle_core.a \
-         lib/libofn_controller_core.a lib/libofn_sensor_interface_core.a lib/libofn_mapper_core.a \
+         lib/libofn_controller_core.a lib/libofn_sensor_interface_core.a lib/libofn_map.a lib/libofn_mapper_core.a \
          lib/libofn_global_planner_core.a lib/libofn_rh_optimizer_core.a lib/libofn_time_optimal.a \
-         include/ofn/nav_state_t.hpp include/ofn/common/validate.hpp include/ofn/mapper/mapper.hpp \
+         include/ofn/nav_state_t.hpp include/ofn/common/validate.hpp include/ofn/mapper/mapper.hpp include/ofn/map/distance_field.hpp \
          include/ofn/rotorcraft_model/rotorcraft_model.hpp include/ofn/sim/time_optimal.hpp \
          share/ofn/python/ofn/__init__.py share/ofn/python/ofn/nav_state_t.py \
          share/ofn/lua/ofn/init.lua share/ofn/lua/ofn/nav_state_t.lua \

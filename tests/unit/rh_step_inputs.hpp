@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 
 namespace ofn::rh::testing_support {

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "ofn/common/scenario.hpp"
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_nlp.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 #include "ofn/world/world.hpp"

@@ -7,7 +7,7 @@
 #include <memory>
 #include <utility>
 
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 #include "rh_step_inputs.hpp"
 

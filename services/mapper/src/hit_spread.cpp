@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "ofn/mapper/cell_key.hpp"
+#include "ofn/map/cell_key.hpp"
 
 namespace ofn::mapping {
 namespace {

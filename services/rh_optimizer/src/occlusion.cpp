@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "ofn/mapper/cell_key.hpp"
+#include "ofn/map/cell_key.hpp"
 
 namespace ofn::rh {
 int64_t VisibilityRecord::key(double north, double east) const {

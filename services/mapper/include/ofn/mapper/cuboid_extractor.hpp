@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "ofn/common/frames.hpp"
-#include "ofn/mapper/heightfield.hpp"
+#include "ofn/map/heightfield.hpp"
 
 namespace ofn::mapping {
 

@@ -11,7 +11,7 @@
 // the acceleration limit does not allow.
 
 #include "ofn/common/frames.hpp"
-#include "ofn/mapper/heightfield.hpp"
+#include "ofn/map/heightfield.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 
 namespace ofn::rh {

@@ -16,7 +16,7 @@
 #include <unordered_set>
 
 #include "ofn/common/frames.hpp"
-#include "ofn/mapper/heightfield.hpp"
+#include "ofn/map/heightfield.hpp"
 
 namespace ofn::rh {
 

@@ -28,7 +28,7 @@
 #include "ofn/common/bspline.hpp"
 #include "ofn/common/frames.hpp"
 #include "ofn/common/scenario.hpp"
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 
 namespace ofn::rh {
 

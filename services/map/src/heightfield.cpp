@@ -1,4 +1,4 @@
-#include "ofn/mapper/heightfield.hpp"
+#include "ofn/map/heightfield.hpp"
 
 #include <cmath>
 #include <limits>

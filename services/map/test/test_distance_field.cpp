@@ -9,7 +9,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 
 namespace ofn::mapping {
 namespace {

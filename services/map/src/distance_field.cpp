@@ -1,4 +1,4 @@
-#include "ofn/mapper/distance_field.hpp"
+#include "ofn/map/distance_field.hpp"
 
 #include <algorithm>
 #include <cmath>
