@@ -142,6 +142,37 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
   return std::nullopt;
 }
 
+std::optional<NarrowPassage> find_cramped_stop(const ClearanceQuery& clearance, const Vec3& stop,
+                                               const Vec3& from, double required,
+                                               const PassageSettings& settings) {
+  if (!clearance || !settings.enabled || !stop.allFinite()) return std::nullopt;
+  // The section normal to the vertical is the horizontal disc round the
+  // stop: any point of it within max_shift may be where the stop is made.
+  const Vec3 vertical = Vec3::UnitZ();
+  const Crossing c = cross(clearance, stop, vertical, required, settings.max_shift);
+  if (c.passable || c.best_distance == -1e300) return std::nullopt;
+  NarrowPassage passage;
+  passage.centre = c.best;
+  passage.clearance = c.best_distance;
+  passage.radius = std::max(1.0, c.best_distance) + 0.5;
+  // The column in which there is no room either, as for a pinch.
+  auto extent = [&](double sign) {
+    double reach = 0;
+    for (double dz = settings.extent_step; dz <= settings.max_extent + 1e-9;
+         dz += settings.extent_step) {
+      const Vec3 p = stop + Vec3(0.0, 0.0, sign * dz);
+      if (cross(clearance, p, vertical, required, settings.max_shift).passable) break;
+      reach = dz;
+    }
+    return reach;
+  };
+  const double up = extent(-1.0), down = extent(1.0);  // NED: up is -z
+  passage.centre.z() = stop.z() + 0.5 * (down - up);
+  passage.half_height = 0.5 * (up + down) + settings.extent_step;
+  if (inside(passage, from)) return std::nullopt;
+  return passage;
+}
+
 bool PassageMemory::add(const NarrowPassage& passage) {
   for (const NarrowPassage& known : passages_)
     if (inside(known, passage.centre)) return false;

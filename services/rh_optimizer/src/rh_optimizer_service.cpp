@@ -467,7 +467,8 @@ void RhOptimizerService::publish_passages(Utime now) {
                 passages_message(passages_.passages(), mission_->mission_id, now));
 }
 
-bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits) {
+bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits,
+                                               const GuidanceFrame& leg) {
   if (!field_valid_) return false;
   // On the field the plans are made on, after the look: the shadows
   // behind what was seen (occlusion) it cleared are gone, those left are
@@ -480,16 +481,30 @@ bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits) 
   // short of the clearance, which it had flown before, and lost its way.
   const double required = (limits.clearance + config_.optimizer.clearance_margin) *
                           (1.0 - config_.optimizer.feasibility_tolerance);
-  const auto pinch = find_narrow_passage(clearance, recovery_route_, required, config_.passages);
+  std::optional<NarrowPassage> pinch =
+      find_narrow_passage(clearance, recovery_route_, required, config_.passages);
+  const char* what = "the route passes a pinch";
+  if (!pinch && !recovery_route_.empty()) {
+    // An escape flies to the route's first corner and stops there; the
+    // route's sections may leave room to pass a corner in a gap but none
+    // to stop in it, and the escape stalled there look after look (dense
+    // seeds 162 and 171).
+    const auto corner = escape_leg_end(recovery_route_, leg, config_.recovery.capture_radius);
+    if (corner && *corner > 0) {
+      pinch = find_cramped_stop(clearance, recovery_route_[*corner], recovery_route_.front(),
+                                required, config_.passages);
+      what = "the escape would stop at a corner with no room";
+    }
+  }
   // One the planner knows already is not its doing (a zone round the
   // start, which routes may leave): the route is taken.
   if (!pinch || !passages_.add(*pinch)) return false;
   const double ground = config_.optimizer.ground_altitude;
   node_.log().warn(
-      "t={:.2f} s the route passes a pinch with {:.2f} m of the {:.2f} m clearance: told to the "
-      "global planner (no route within {:.1f} m of ({:.1f}, {:.1f}) m north/east, {:.1f} to "
-      "{:.1f} m above the ground)",
-      to_seconds(now), pinch->clearance, required, pinch->radius, pinch->centre.x(),
+      "t={:.2f} s {} with {:.2f} m of the {:.2f} m clearance: told to the global planner (no "
+      "route within {:.1f} m of ({:.1f}, {:.1f}) m north/east, {:.1f} to {:.1f} m above the "
+      "ground)",
+      to_seconds(now), what, pinch->clearance, required, pinch->radius, pinch->centre.x(),
       pinch->centre.y(), -(pinch->centre.z() + pinch->half_height) - ground,
       -(pinch->centre.z() - pinch->half_height) - ground);
   publish_passages(now);
@@ -512,7 +527,7 @@ RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
   in.route_time = route_kind_utime_ == INT64_MIN ? -1e300 : to_seconds(route_kind_utime_);
   in.route_points = &recovery_route_;
   in.leg = GuidanceFrame::from_leg(leg.from, leg.to);
-  in.route_flyable = [&] { return !check_route_for_pinch(now, limits); };
+  in.route_flyable = [&] { return !check_route_for_pinch(now, limits, in.leg); };
   RecoveryDecision decision = recovery_.update(in);
   if (decision.changed) {
     node_.log().warn("t={:.2f} s recovery: {}: {}", in.time, to_string(decision.phase),
@@ -708,9 +723,15 @@ void RhOptimizerService::tick() {
     // The leg of the escape: from where it began to where the route turns
     // forward again, along the route; the forward-speed rule of Eq. 8 is
     // relaxed (the route may bend back), the commit gate is not.
-    const Vec3 leg_end = clear_of_obstacles(
-        clearance, recovery.escape_point,
-        limits.clearance + config_.optimizer.clearance_margin + kEscapeEndMargin);
+    const double planned_clearance = limits.clearance + config_.optimizer.clearance_margin;
+    Vec3 leg_end =
+        clear_of_obstacles(clearance, recovery.escape_point, planned_clearance + kEscapeEndMargin);
+    // A corner in a gap may have room for the optimiser's clearance but not
+    // for the margin on top (the route check asks only for the clearance):
+    // the escape then stops at the clearance itself. Kept to the margin, its
+    // end lay where no plan could reach it.
+    if (clearance && clearance(leg_end).distance < planned_clearance + kEscapeEndMargin)
+      leg_end = clear_of_obstacles(clearance, recovery.escape_point, planned_clearance);
     p.frame = GuidanceFrame::from_leg(recovery.escape_from, leg_end);
     p.target = leg_end;
     const double x_escape = p.frame.to_guidance(leg_end).x();

@@ -119,6 +119,30 @@ TEST(NarrowPassage, NoQueryOrTooShortARouteFindsNothing) {
   EXPECT_FALSE(find_narrow_passage(gap_of(12), {Vec3(60, 0, -kLegAltitude)}, kRequired));
 }
 
+// A route that bends in a gap: it may pass the corner, but an escape leg
+// stopping there has no room to stop with the clearance.
+TEST(CrampedStop, AStopInAGapNarrowerThanTwiceTheClearanceHasNoRoom) {
+  const ClearanceQuery clearance = gap_of(12);
+  const Vec3 corner(60.0, 0.0, -kLegAltitude), vehicle(20.0, 0.0, -kLegAltitude);
+  const auto zone = find_cramped_stop(clearance, corner, vehicle, kRequired);
+  ASSERT_TRUE(zone.has_value());
+  EXPECT_LT(zone->clearance, kRequired);
+  EXPECT_LT((zone->centre.head<2>() - corner.head<2>()).norm(), 3.0 + 1e-9);
+  // The zone reaches the walls, and the column goes up to about the tops.
+  EXPECT_GE(zone->radius, zone->clearance);
+  const double top = -(zone->centre.z() - zone->half_height);
+  EXPECT_GT(top, 60.0);
+  EXPECT_LE(top, 60.0 + kRequired + 1.5);
+  // Wide enough, or the corner 10 m before the gap: room to stop.
+  EXPECT_FALSE(find_cramped_stop(gap_of(16), corner, vehicle, kRequired).has_value());
+  EXPECT_FALSE(
+      find_cramped_stop(clearance, Vec3(40.0, 0.0, -kLegAltitude), vehicle, kRequired).has_value());
+  // A vehicle inside the zone (stopped in the gap) may leave it.
+  EXPECT_FALSE(
+      find_cramped_stop(clearance, corner, Vec3(58.0, 0.0, -kLegAltitude), kRequired).has_value());
+  EXPECT_FALSE(find_cramped_stop(ClearanceQuery{}, corner, vehicle, kRequired).has_value());
+}
+
 TEST(PassageMemory, KeepsEachPassageOnceAndTheNewestWithinItsCapacity) {
   PassageMemory memory(2);
   const NarrowPassage a{Vec3(60, 0, -30), 6.0, 3.0, 5.5};

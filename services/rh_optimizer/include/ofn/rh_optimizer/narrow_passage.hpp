@@ -56,6 +56,18 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
                                                  const std::vector<Vec3>& route, double required,
                                                  const PassageSettings& settings = {});
 
+/// A point at which a route must stop (an escape leg of the dead-end
+/// recovery ends at the route's first corner, from rest to rest) with no
+/// point of the horizontal disc within settings.max_shift of it that has
+/// `required` clearance: no plan can end there, and an escape to it would
+/// stall look after look. The zone round the disc's widest spot, over the
+/// column of altitudes in which there is no room either, as for a pinch.
+/// nullopt when there is room, or when the zone holds `from` (the vehicle:
+/// routes may leave it).
+std::optional<NarrowPassage> find_cramped_stop(const ClearanceQuery& clearance, const Vec3& stop,
+                                               const Vec3& from, double required,
+                                               const PassageSettings& settings = {});
+
 /// The passages found in one mission, for the global planner.
 class PassageMemory {
  public:

@@ -133,9 +133,10 @@ class RhOptimizerService {
   /// The mission's passages, for the global planner (on change and 1 Hz).
   void publish_passages(Utime now);
   /// The route the recovery is about to take after a look: a new pinch on
-  /// it is remembered and published, so that the planner's next route goes
-  /// another way. True if one was.
-  bool check_route_for_pinch(Utime now, const Limits& limits);
+  /// it, or no room to stop at the corner its escape would stop at, is
+  /// remembered and published, so that the planner's next route goes
+  /// another way. True if one was. `leg`: the mission leg's frame.
+  bool check_route_for_pinch(Utime now, const Limits& limits, const GuidanceFrame& leg);
   /// Feeds the dead-end recovery; logs and acts on a change of its phase.
   RecoveryDecision update_recovery(Utime now, const Leg& leg, const Limits& limits,
                                    const Vec3& position, const Vec3& velocity, bool engaged);
