@@ -84,6 +84,26 @@ Crossing cross(const ClearanceQuery& clearance, const Vec3& point, const Vec3& t
   return c;
 }
 
+// Sets the passage's column: the altitudes about `point`, every
+// extent_step out to max_extent up and down, at which `open` does not hold
+// (the column's ends are known to a step; a step more above and below).
+template <class Open>
+void set_column(NarrowPassage& passage, const Vec3& point, const PassageSettings& settings,
+                const Open& open) {
+  auto extent = [&](double sign) {
+    double reach = 0;
+    for (double dz = settings.extent_step; dz <= settings.max_extent + 1e-9;
+         dz += settings.extent_step) {
+      if (open(point + Vec3(0.0, 0.0, sign * dz))) break;
+      reach = dz;
+    }
+    return reach;
+  };
+  const double up = extent(-1.0), down = extent(1.0);  // NED: up is -z
+  passage.centre.z() = point.z() + 0.5 * (down - up);
+  passage.half_height = 0.5 * (up + down) + settings.extent_step;
+}
+
 }  // namespace
 
 std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance,
@@ -115,24 +135,12 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
     const Vec3 level_tangent = Vec3(direction.x(), direction.y(), 0.0).norm() > 1e-6
                                    ? Vec3(direction.x(), direction.y(), 0.0).normalized()
                                    : direction.normalized();
-    auto extent = [&](double sign) {
-      double reach = 0;
-      for (double dz = settings.extent_step; dz <= settings.max_extent + 1e-9;
-           dz += settings.extent_step) {
-        const Vec3 p = route[k] + Vec3(0.0, 0.0, sign * dz);
-        if (cross(clearance, p, level_tangent, required, settings.max_shift, true).passable) break;
-        reach = dz;
-      }
-      return reach;
-    };
     // Searched about the route point, as the pinch was: about the widest
     // spot, up to max_shift aside, a section could reach a clear point
     // the route's own could not.
-    const double up = extent(-1.0), down = extent(1.0);  // NED: up is -z
-    passage.centre.z() = route[k].z() + 0.5 * (down - up);
-    // The column's ends are known to a step; above and below them the gap
-    // can be crossed level.
-    passage.half_height = 0.5 * (up + down) + settings.extent_step;
+    set_column(passage, route[k], settings, [&](const Vec3& p) {
+      return cross(clearance, p, level_tangent, required, settings.max_shift, true).passable;
+    });
     // A pinch round the route's start (the vehicle, stopped in a narrow
     // spot) cannot be routed round: the planner lets routes leave it. Look
     // for one farther on.
@@ -156,19 +164,9 @@ std::optional<NarrowPassage> find_cramped_stop(const ClearanceQuery& clearance, 
   passage.clearance = c.best_distance;
   passage.radius = std::max(1.0, c.best_distance) + 0.5;
   // The column in which there is no room either, as for a pinch.
-  auto extent = [&](double sign) {
-    double reach = 0;
-    for (double dz = settings.extent_step; dz <= settings.max_extent + 1e-9;
-         dz += settings.extent_step) {
-      const Vec3 p = stop + Vec3(0.0, 0.0, sign * dz);
-      if (cross(clearance, p, vertical, required, settings.max_shift).passable) break;
-      reach = dz;
-    }
-    return reach;
-  };
-  const double up = extent(-1.0), down = extent(1.0);  // NED: up is -z
-  passage.centre.z() = stop.z() + 0.5 * (down - up);
-  passage.half_height = 0.5 * (up + down) + settings.extent_step;
+  set_column(passage, stop, settings, [&](const Vec3& p) {
+    return cross(clearance, p, vertical, required, settings.max_shift).passable;
+  });
   if (inside(passage, from)) return std::nullopt;
   return passage;
 }

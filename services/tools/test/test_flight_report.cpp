@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -44,15 +45,23 @@ class FlightReport : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   template <class Msg>
-  static void write(lcm::LogFile& log, const std::string& channel, const Msg& m, Utime t) {
+  static std::vector<uint8_t> encoded(const Msg& m) {
     std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
     m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    return bytes;
+  }
+  static void write_bytes(lcm::LogFile& log, const std::string& channel, std::vector<uint8_t> bytes,
+                          Utime t) {
     lcm::LogEvent e{};
     e.timestamp = t;
     e.channel = channel;
     e.datalen = static_cast<int32_t>(bytes.size());
     e.data = bytes.data();
     log.writeEvent(&e);
+  }
+  template <class Msg>
+  static void write(lcm::LogFile& log, const std::string& channel, const Msg& m, Utime t) {
+    write_bytes(log, channel, encoded(m), t);
   }
 
   /// A hover of `seconds` at `here`: NAV_STATE at 100 Hz, CONTROL_STATUS at
@@ -266,15 +275,9 @@ TEST_F(FlightReport, WithTheKeyringOnlyWhatTheRolesSignedIsRead) {
                                [&wall] { return wall; });
   const auto record = [&](lcm::LogFile& log, auth::Authenticator* signer,
                           const std::string& channel, const auto& m) {
-    std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
-    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    std::vector<uint8_t> bytes = encoded(m);
     if (signer) signer->seal(channel, bytes);
-    lcm::LogEvent e{};
-    e.timestamp = wall;
-    e.channel = channel;
-    e.datalen = static_cast<int32_t>(bytes.size());
-    e.data = bytes.data();
-    log.writeEvent(&e);
+    write_bytes(log, channel, std::move(bytes), wall);
   };
   const Scenario open = load_scenario(kOpenScenario);
   const std::string path = (dir_ / "signed.lcm").string();
