@@ -488,7 +488,7 @@ bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits,
     // An escape flies to the route's first corner and stops there; the
     // route's sections may leave room to pass a corner in a gap but none
     // to stop in it, and the escape stalled there look after look (dense
-    // seeds 162 and 171).
+    // seed 162).
     const auto corner = escape_leg_end(recovery_route_, leg, config_.recovery.capture_radius);
     if (corner && *corner > 0) {
       pinch = find_cramped_stop(clearance, recovery_route_[*corner], recovery_route_.front(),
