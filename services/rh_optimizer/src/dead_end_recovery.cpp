@@ -59,33 +59,6 @@ std::optional<size_t> forward_from(const std::vector<Vec3>& route, const Guidanc
   return k;
 }
 
-Vec3 clear_of_obstacles(const ClearanceQuery& clearance, const Vec3& point, double required,
-                        double max_shift) {
-  if (!clearance) return point;
-  Vec3 p = point;
-  for (int i = 0; i < 20; ++i) {
-    const mapping::DistanceSample d = clearance(p);
-    if (!(d.distance < required)) return p;
-    const Vec3 up(d.gradient.x(), d.gradient.y(), 0.0);
-    if (up.norm() < 1e-6) break;
-    p += up.normalized() * std::min(0.5, required - d.distance + 0.05);
-    if ((p - point).norm() > max_shift) break;
-  }
-  // The gradient can end in a saddle between two obstacles, or lead the
-  // wrong way round a corner, where a step to one side would do: the
-  // nearest point with the clearance on rings every 0.5 m out to
-  // max_shift, 16 bearings each (the room find_cramped_stop looks for).
-  constexpr int kBearings = 16;
-  for (double radius = 0.5; radius <= max_shift + 1e-9; radius += 0.5) {
-    for (int k = 0; k < kBearings; ++k) {
-      const double bearing = 2.0 * M_PI * k / kBearings;
-      const Vec3 q = point + radius * Vec3(std::cos(bearing), std::sin(bearing), 0.0);
-      if (clearance(q).distance >= required) return q;
-    }
-  }
-  return point;
-}
-
 void DeadEndRecovery::reset() {
   decision_ = RecoveryDecision{};
   stuck_since_.reset();

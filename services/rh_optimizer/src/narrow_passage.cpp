@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace ofn::rh {
 namespace {
@@ -51,15 +52,23 @@ Crossing cross(const ClearanceQuery& clearance, const Vec3& point, const Vec3& t
   Vec3 across = tangent.cross(Vec3::UnitZ());
   across = across.norm() > 1e-6 ? across.normalized() : Vec3::UnitX();
   const Vec3 other = across.cross(tangent).normalized();
+  // Nearest first: where the section is passable, the point reported is
+  // the nearest sample with the clearance (an escape's end moves no farther
+  // from the route's corner than it must). Whether it is passable does not
+  // depend on the order.
   const int n = static_cast<int>(std::floor(max_shift / kSampleSpacing));
+  std::vector<Vec3> offsets;
   for (int a = -n; a <= n; ++a)
     for (int b = level ? 0 : -n; b <= (level ? 0 : n); ++b) {
       const Vec3 offset = kSampleSpacing * (a * across + b * other);
-      if (offset.norm() > max_shift || (a == 0 && b == 0)) continue;
-      if (sample(point + offset)) {
-        c.passable = true;
-        return c;
-      }
+      if (offset.norm() <= max_shift && (a != 0 || b != 0)) offsets.push_back(offset);
+    }
+  std::stable_sort(offsets.begin(), offsets.end(),
+                   [](const Vec3& l, const Vec3& r) { return l.squaredNorm() < r.squaredNorm(); });
+  for (const Vec3& offset : offsets)
+    if (sample(point + offset)) {
+      c.passable = true;
+      return c;
     }
   if (c.best_distance == -1e300) return c;
   Vec3 p = c.best;
@@ -150,24 +159,38 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
   return std::nullopt;
 }
 
-std::optional<NarrowPassage> find_cramped_stop(const ClearanceQuery& clearance, const Vec3& stop,
-                                               const Vec3& from, double required,
-                                               const PassageSettings& settings) {
-  if (!clearance || !settings.enabled || !stop.allFinite()) return std::nullopt;
+std::optional<Vec3> room_to_stop(const ClearanceQuery& clearance, const Vec3& point,
+                                 double required, double max_shift) {
+  if (!clearance || !point.allFinite()) return std::nullopt;
   // The section normal to the vertical is the horizontal disc round the
-  // stop: any point of it within max_shift may be where the stop is made.
+  // point.
+  const Crossing c = cross(clearance, point, Vec3::UnitZ(), required, max_shift);
+  if (!c.passable) return std::nullopt;
+  return c.best;
+}
+
+std::optional<NarrowPassage> find_cramped_stop(const ClearanceQuery& clearance, const Vec3& stop,
+                                               double required, const PassageSettings& settings) {
+  if (!clearance || !settings.enabled || !stop.allFinite()) return std::nullopt;
+  // The disc room_to_stop searches: any point of it within max_shift may be
+  // where the stop is made.
   const Vec3 vertical = Vec3::UnitZ();
   const Crossing c = cross(clearance, stop, vertical, required, settings.max_shift);
   if (c.passable || c.best_distance == -1e300) return std::nullopt;
   NarrowPassage passage;
-  passage.centre = c.best;
+  // Round the stop, over the whole disc without room: a route that turns
+  // anywhere in it would stop there. (Round the disc's widest spot with
+  // that spot's clearance, as for a pinch, the zone held the vehicle 8 m
+  // back on dense seed 171 and the corner was not reported.) A vehicle
+  // inside sees the zone shrunk to its own distance from the axis (the
+  // planner lets routes leave it), which still keeps routes off the stop.
+  passage.centre = stop;
   passage.clearance = c.best_distance;
-  passage.radius = std::max(1.0, c.best_distance) + 0.5;
+  passage.radius = settings.max_shift + 0.5;
   // The column in which there is no room either, as for a pinch.
   set_column(passage, stop, settings, [&](const Vec3& p) {
     return cross(clearance, p, vertical, required, settings.max_shift).passable;
   });
-  if (inside(passage, from)) return std::nullopt;
   return passage;
 }
 

@@ -467,6 +467,14 @@ void RhOptimizerService::publish_passages(Utime now) {
                 passages_message(passages_.passages(), mission_->mission_id, now));
 }
 
+double RhOptimizerService::pinch_clearance(const Limits& limits) const {
+  // What the optimiser accepts as feasible: its clearance, less its
+  // (normalised) feasibility tolerance. Dense seed 83 blocked a gap 1 cm
+  // short of the clearance, which it had flown before, and lost its way.
+  return (limits.clearance + config_.optimizer.clearance_margin) *
+         (1.0 - config_.optimizer.feasibility_tolerance);
+}
+
 bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits,
                                                const GuidanceFrame& leg) {
   if (!field_valid_) return false;
@@ -476,11 +484,7 @@ bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits,
   // before the look, a gap they closed then was open after it: dense seed
   // 68 lost its way so.)
   const ClearanceQuery clearance = [this](const Vec3& p) { return field_.query(p); };
-  // What the optimiser accepts as feasible: its clearance, less its
-  // (normalised) feasibility tolerance. Dense seed 83 blocked a gap 1 cm
-  // short of the clearance, which it had flown before, and lost its way.
-  const double required = (limits.clearance + config_.optimizer.clearance_margin) *
-                          (1.0 - config_.optimizer.feasibility_tolerance);
+  const double required = pinch_clearance(limits);
   std::optional<NarrowPassage> pinch =
       find_narrow_passage(clearance, recovery_route_, required, config_.passages);
   const char* what = "the route passes a pinch";
@@ -491,8 +495,7 @@ bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits,
     // seed 162).
     const auto corner = escape_leg_end(recovery_route_, leg, config_.recovery.capture_radius);
     if (corner && *corner > 0) {
-      pinch = find_cramped_stop(clearance, recovery_route_[*corner], recovery_route_.front(),
-                                required, config_.passages);
+      pinch = find_cramped_stop(clearance, recovery_route_[*corner], required, config_.passages);
       what = "the escape would stop at a corner with no room";
     }
   }
@@ -724,14 +727,20 @@ void RhOptimizerService::tick() {
     // forward again, along the route; the forward-speed rule of Eq. 8 is
     // relaxed (the route may bend back), the commit gate is not.
     const double planned_clearance = limits.clearance + config_.optimizer.clearance_margin;
-    Vec3 leg_end =
-        clear_of_obstacles(clearance, recovery.escape_point, planned_clearance + kEscapeEndMargin);
-    // A corner in a gap may have room for the optimiser's clearance but not
-    // for the margin on top (the route check asks only for the clearance):
-    // the escape then stops at the clearance itself. Kept to the margin, its
-    // end lay where no plan could reach it.
-    if (clearance && clearance(leg_end).distance < planned_clearance + kEscapeEndMargin)
-      leg_end = clear_of_obstacles(clearance, recovery.escape_point, planned_clearance);
+    // The end is looked for as the route check looked for room at the
+    // corner (room_to_stop): kept kEscapeEndMargin beyond the clearance
+    // where that fits, else at the clearance, else at what the check asked
+    // (the clearance less the solver's tolerance), which the check found.
+    // Searched another way (a gradient, then rings), a corner the check
+    // passed could be one where the escape found no end, and stalled.
+    Vec3 leg_end = recovery.escape_point;
+    for (const double wanted :
+         {planned_clearance + kEscapeEndMargin, planned_clearance, pinch_clearance(limits)})
+      if (const auto room =
+              room_to_stop(clearance, recovery.escape_point, wanted, config_.passages.max_shift)) {
+        leg_end = *room;
+        break;
+      }
     p.frame = GuidanceFrame::from_leg(recovery.escape_from, leg_end);
     p.target = leg_end;
     const double x_escape = p.frame.to_guidance(leg_end).x();

@@ -270,37 +270,6 @@ std::vector<Vec3> route_out_of_the_u(const Vec3& from) {
 // The verdict knows an escape by its mark; a blind step in the middle of an
 // escape (the map starved, the controller flying the escape's stop) keeps
 // it, or the escape's backward flight would be judged as a forward leg's.
-// Where the gradient gives no way (a saddle, a flat spot), the nearest room
-// within the shift is still found; with none, the point stays.
-TEST(ClearOfObstacles, WhereTheGradientGivesNoWayTheNearestRoomIsFound) {
-  const Vec3 point(0.0, 0.0, -kLegAltitude);
-  const ClearanceQuery east_is_clear = [](const Vec3& p) {
-    mapping::DistanceSample s;
-    s.distance = p.y() > 1.4 ? 7.0 : 5.0;  // no gradient anywhere
-    return s;
-  };
-  const Vec3 moved = clear_of_obstacles(east_is_clear, point, 6.6);
-  EXPECT_NEAR(moved.x(), 0.0, 1e-9);
-  EXPECT_NEAR(moved.y(), 1.5, 1e-9);
-  EXPECT_EQ(moved.z(), point.z());
-  const ClearanceQuery nowhere = [](const Vec3&) {
-    mapping::DistanceSample s;
-    s.distance = 5.0;
-    return s;
-  };
-  EXPECT_EQ(clear_of_obstacles(nowhere, point, 6.6), point);
-  // Up the gradient where it leads there: a wall to the west.
-  const ClearanceQuery wall = [](const Vec3& p) {
-    mapping::DistanceSample s;
-    s.distance = 6.0 + p.y();
-    s.gradient = Vec3::UnitY();
-    return s;
-  };
-  const Vec3 climbed = clear_of_obstacles(wall, point, 6.6);
-  EXPECT_GE(wall(climbed).distance, 6.6);
-  EXPECT_LT(climbed.y(), 0.7);
-}
-
 TEST(RecoveryMessage, MarksEveryStepOfAnEscapeOnce) {
   EXPECT_EQ(recovery_message(RecoveryPhase::kEscaping, "solved"), "escaping: solved");
   EXPECT_EQ(recovery_message(RecoveryPhase::kEscaping, "map starved of scans: 17 %"),

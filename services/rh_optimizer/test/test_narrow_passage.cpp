@@ -123,24 +123,65 @@ TEST(NarrowPassage, NoQueryOrTooShortARouteFindsNothing) {
 // stopping there has no room to stop with the clearance.
 TEST(CrampedStop, AStopInAGapNarrowerThanTwiceTheClearanceHasNoRoom) {
   const ClearanceQuery clearance = gap_of(12);
-  const Vec3 corner(60.0, 0.0, -kLegAltitude), vehicle(20.0, 0.0, -kLegAltitude);
-  const auto zone = find_cramped_stop(clearance, corner, vehicle, kRequired);
+  const Vec3 corner(60.0, 0.0, -kLegAltitude);
+  const auto zone = find_cramped_stop(clearance, corner, kRequired);
   ASSERT_TRUE(zone.has_value());
   EXPECT_LT(zone->clearance, kRequired);
-  EXPECT_LT((zone->centre.head<2>() - corner.head<2>()).norm(), 3.0 + 1e-9);
-  // The zone reaches the walls, and the column goes up to about the tops.
-  EXPECT_GE(zone->radius, zone->clearance);
+  // Round the stop, over the disc without room.
+  EXPECT_EQ(zone->centre.head<2>(), corner.head<2>());
+  EXPECT_DOUBLE_EQ(zone->radius, PassageSettings{}.max_shift + 0.5);
+  // The column goes up to about the tops.
   const double top = -(zone->centre.z() - zone->half_height);
   EXPECT_GT(top, 60.0);
   EXPECT_LE(top, 60.0 + kRequired + 1.5);
   // Wide enough, or the corner 10 m before the gap: room to stop.
-  EXPECT_FALSE(find_cramped_stop(gap_of(16), corner, vehicle, kRequired).has_value());
-  EXPECT_FALSE(
-      find_cramped_stop(clearance, Vec3(40.0, 0.0, -kLegAltitude), vehicle, kRequired).has_value());
-  // A vehicle inside the zone (stopped in the gap) may leave it.
-  EXPECT_FALSE(
-      find_cramped_stop(clearance, corner, Vec3(58.0, 0.0, -kLegAltitude), kRequired).has_value());
-  EXPECT_FALSE(find_cramped_stop(ClearanceQuery{}, corner, vehicle, kRequired).has_value());
+  EXPECT_FALSE(find_cramped_stop(gap_of(16), corner, kRequired).has_value());
+  EXPECT_FALSE(find_cramped_stop(clearance, Vec3(40.0, 0.0, -kLegAltitude), kRequired).has_value());
+  EXPECT_FALSE(find_cramped_stop(ClearanceQuery{}, corner, kRequired).has_value());
+}
+
+// One search for both: where the check finds room at a corner, the escape's
+// end is the nearest such point; where it finds none, there is no end.
+TEST(RoomToStop, TheNearestPointWithTheClearanceIsWhereTheStopIsMade) {
+  const Vec3 corner(60.0, 0.0, -kLegAltitude);
+  // The corner in the 12 m gap: no room; 10 m before it, room.
+  EXPECT_FALSE(room_to_stop(gap_of(12), corner, kRequired, 3.0).has_value());
+  const Vec3 before(40.0, 0.0, -kLegAltitude);
+  const auto free = room_to_stop(gap_of(12), before, kRequired, 3.0);
+  ASSERT_TRUE(free.has_value());
+  EXPECT_EQ(*free, before);
+  // No gradient anywhere, room only east of 1.4 m: the nearest sample
+  // there, 1.5 m due east.
+  const ClearanceQuery east_is_clear = [](const Vec3& p) {
+    mapping::DistanceSample s;
+    s.distance = p.y() > 1.4 ? 7.0 : 5.0;
+    return s;
+  };
+  const auto moved = room_to_stop(east_is_clear, corner, 6.6, 3.0);
+  ASSERT_TRUE(moved.has_value());
+  EXPECT_NEAR(moved->x(), corner.x(), 1e-9);
+  EXPECT_NEAR(moved->y(), 1.5, 1e-9);
+  EXPECT_EQ(moved->z(), corner.z());
+  EXPECT_FALSE(room_to_stop(east_is_clear, corner, 6.6, 1.0).has_value());
+  // Up the gradient past the samples' spacing: a wall to the west.
+  const ClearanceQuery wall = [](const Vec3& p) {
+    mapping::DistanceSample s;
+    s.distance = 6.0 + p.y();
+    s.gradient = Vec3::UnitY();
+    return s;
+  };
+  const auto climbed = room_to_stop(wall, corner, 6.6, 3.0);
+  ASSERT_TRUE(climbed.has_value());
+  EXPECT_GE(wall(*climbed).distance, 6.6);
+  EXPECT_LE(climbed->y(), 1.0 + 1e-9);
+  // Agreement with the check, corner by corner along the gap's approach.
+  for (double north = 30.0; north <= 70.0; north += 2.5) {
+    const Vec3 stop(north, 0.0, -kLegAltitude);
+    EXPECT_EQ(room_to_stop(gap_of(12), stop, kRequired, 3.0).has_value(),
+              !find_cramped_stop(gap_of(12), stop, kRequired).has_value())
+        << north;
+  }
+  EXPECT_FALSE(room_to_stop(ClearanceQuery{}, corner, kRequired, 3.0).has_value());
 }
 
 TEST(PassageMemory, KeepsEachPassageOnceAndTheNewestWithinItsCapacity) {

@@ -146,15 +146,6 @@ std::optional<size_t> forward_from(const std::vector<Vec3>& route, const Guidanc
 std::optional<size_t> escape_leg_end(const std::vector<Vec3>& route, const GuidanceFrame& leg,
                                      double min_length = 0.0, double corner_angle = 0.26);
 
-/// `point` moved up the clearance gradient until it is at least `required`
-/// from the mapped obstacles (at most `max_shift` m, horizontally): an
-/// escape leg stops exactly at its end, and a route node sits at R_s from
-/// its cuboid, inside the optimiser's R_s plus margin from the grid. Where
-/// the gradient does not get there, the nearest point of rings 0.5 m apart
-/// out to `max_shift` that has the clearance; `point` itself when none has.
-Vec3 clear_of_obstacles(const ClearanceQuery& clearance, const Vec3& point, double required,
-                        double max_shift = 3.0);
-
 class DeadEndRecovery {
  public:
   explicit DeadEndRecovery(RecoverySettings settings = {}) : settings_(settings) {}

@@ -56,16 +56,25 @@ std::optional<NarrowPassage> find_narrow_passage(const ClearanceQuery& clearance
                                                  const std::vector<Vec3>& route, double required,
                                                  const PassageSettings& settings = {});
 
+/// Where a stop meant for `point` can be made: the nearest point of the
+/// horizontal disc within `max_shift` of it that has `required` clearance
+/// (sampled every 0.5 m nearest first, then climbed from the widest
+/// sample), `point` itself when it has. nullopt when the disc has no room,
+/// for an empty query or a non-finite point. The one search both the
+/// route check (find_cramped_stop) and the escape leg's end use: a corner
+/// the check passes is one the escape finds room at.
+std::optional<Vec3> room_to_stop(const ClearanceQuery& clearance, const Vec3& point,
+                                 double required, double max_shift);
+
 /// A point at which a route must stop (an escape leg of the dead-end
-/// recovery ends at the route's first corner, from rest to rest) with no
-/// point of the horizontal disc within settings.max_shift of it that has
-/// `required` clearance: no plan can end there, and an escape to it would
-/// stall look after look. The zone round the disc's widest spot, over the
-/// column of altitudes in which there is no room either, as for a pinch.
-/// nullopt when there is room, or when the zone holds `from` (the vehicle:
-/// routes may leave it).
+/// recovery ends at the route's first corner, from rest to rest) where
+/// room_to_stop finds no room within settings.max_shift: no plan can end
+/// there, and an escape to it would stall look after look. The zone: round
+/// the stop, radius max_shift + 0.5 m (the disc without room), over the
+/// column of altitudes in which there is no room either, as for a pinch;
+/// its clearance is the most the disc offers. nullopt when there is room.
 std::optional<NarrowPassage> find_cramped_stop(const ClearanceQuery& clearance, const Vec3& stop,
-                                               const Vec3& from, double required,
+                                               double required,
                                                const PassageSettings& settings = {});
 
 /// The passages found in one mission, for the global planner.

@@ -132,6 +132,9 @@ class RhOptimizerService {
   void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
   /// The mission's passages, for the global planner (on change and 1 Hz).
   void publish_passages(Utime now);
+  /// The clearance a route's pinches and stops are checked for: what the
+  /// optimiser accepts as feasible.
+  double pinch_clearance(const Limits& limits) const;
   /// The route the recovery is about to take after a look: a new pinch on
   /// it, or no room to stop at the corner its escape would stop at, is
   /// remembered and published, so that the planner's next route goes
