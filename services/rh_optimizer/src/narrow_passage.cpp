@@ -32,9 +32,11 @@ struct Crossing {
 // section is sampled every kSampleSpacing first (a gradient climb from the
 // route point alone follows the slope up a nearby top and gives up, where
 // a step sideways would have been clear), then the clearance is climbed
-// from the best sample within the section.
+// from the best sample within the section. Where the section is passable,
+// `best` is a point of it with the clearance: with `nearest`, the nearest
+// sample that has it (or the point the climb reached).
 Crossing cross(const ClearanceQuery& clearance, const Vec3& point, const Vec3& tangent,
-               double required, double max_shift, bool level = false) {
+               double required, double max_shift, bool level = false, bool nearest = false) {
   Crossing c;
   auto sample = [&](const Vec3& p) {
     const double d = clearance(p).distance;
@@ -52,10 +54,6 @@ Crossing cross(const ClearanceQuery& clearance, const Vec3& point, const Vec3& t
   Vec3 across = tangent.cross(Vec3::UnitZ());
   across = across.norm() > 1e-6 ? across.normalized() : Vec3::UnitX();
   const Vec3 other = across.cross(tangent).normalized();
-  // Nearest first: where the section is passable, the point reported is
-  // the nearest sample with the clearance (an escape's end moves no farther
-  // from the route's corner than it must). Whether it is passable does not
-  // depend on the order.
   const int n = static_cast<int>(std::floor(max_shift / kSampleSpacing));
   std::vector<Vec3> offsets;
   for (int a = -n; a <= n; ++a)
@@ -63,11 +61,24 @@ Crossing cross(const ClearanceQuery& clearance, const Vec3& point, const Vec3& t
       const Vec3 offset = kSampleSpacing * (a * across + b * other);
       if (offset.norm() <= max_shift && (a != 0 || b != 0)) offsets.push_back(offset);
     }
-  std::stable_sort(offsets.begin(), offsets.end(),
-                   [](const Vec3& l, const Vec3& r) { return l.squaredNorm() < r.squaredNorm(); });
   for (const Vec3& offset : offsets)
     if (sample(point + offset)) {
       c.passable = true;
+      if (nearest) {
+        // The nearest sample with the clearance (one exists: this one),
+        // so that a stop moves no farther from its point than it must.
+        std::stable_sort(offsets.begin(), offsets.end(), [](const Vec3& l, const Vec3& r) {
+          return l.squaredNorm() < r.squaredNorm();
+        });
+        for (const Vec3& near : offsets) {
+          const double d = clearance(point + near).distance;
+          if (std::isfinite(d) && d >= required) {
+            c.best = point + near;
+            c.best_distance = d;
+            break;
+          }
+        }
+      }
       return c;
     }
   if (c.best_distance == -1e300) return c;
@@ -164,7 +175,7 @@ std::optional<Vec3> room_to_stop(const ClearanceQuery& clearance, const Vec3& po
   if (!clearance || !point.allFinite()) return std::nullopt;
   // The section normal to the vertical is the horizontal disc round the
   // point.
-  const Crossing c = cross(clearance, point, Vec3::UnitZ(), required, max_shift);
+  const Crossing c = cross(clearance, point, Vec3::UnitZ(), required, max_shift, false, true);
   if (!c.passable) return std::nullopt;
   return c.best;
 }
