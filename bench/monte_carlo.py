@@ -2,15 +2,17 @@
 """Monte Carlo over seeded random obstacle fields: success rate, clearance and time ratio.
 
 Usage: monte_carlo.py [--build DIR] [--runs N] [--seed-base S] [--jobs N] [--out DIR]
-                      [--dense] [--keep-failures] [--keep-all] [--quick]
+                      [--dense | --trap] [--keep-failures] [--keep-all] [--quick]
 
 Field i is bench/random_field.py's field of seed S + i: a fair one (a route
 always exists) by default, a dense one with --dense (10-25 obstacles, may be
-sealed); the rules of both are in that file. Each field is flown in the
+sealed), a trap field with --trap (a dead end, a wall wider than the map or
+a narrow pocket, clutter, sometimes a pop-up; may be sealed); the rules of
+all three are in that file. Each field is flown in the
 lockstep runner, N at a time, and, when the build has ofn_baseline, given
 its time-optimal baseline. Writes OUT/report.md, OUT/results.json (every
 run), OUT/clearance.png, OUT/time_ratio.png, OUT/fields/field-SEED.yaml
-(dense-SEED.yaml with --dense) and, for failed runs, a figure
+(dense-SEED.yaml with --dense, trap-SEED.yaml with --trap) and, for failed runs, a figure
 OUT/failure-figures/fig-seed-SEED.png.
 
 Every flight ends in one outcome (../shared/BENCHMARKS.md): success (finish
@@ -26,7 +28,7 @@ given the seed, so any of them can be flown again alone: the report gives
 the command for each failure.
 
 Exit code: fair fields, 1 when the success rate is below 99 % (the goal);
-dense fields, 1 when any field fails (a failure outcome, a safe stop
+dense and trap fields, 1 when any field fails (a failure outcome, a safe stop
 although the baseline finds a route, a clearance below 0.8 R_s or a limit
 exceeded); 2 for bad arguments. The report is written either way.
 """
@@ -104,15 +106,15 @@ def rerun_commands(args, seed):
     gen = os.path.join(HERE, "random_field.py")
     tpl = "" if os.path.realpath(args.template) == os.path.realpath(random_field.DEFAULT_TEMPLATE) \
         else " --template " + os.path.abspath(args.template)
-    dense = " --dense" if args.dense else ""
+    kind = KIND_FLAGS[args.kind]
     name = field_name(args, seed)
     link = "".join(" --%s %g" % (flag, value) for flag, value in
                    (("link-loss", args.link_loss), ("link-delay", args.link_delay),
                     ("link-jitter", args.link_jitter)) if value > 0)
     one = "%s --build %s --config-dir %s%s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
-        me, args.build, args.config_dir, tpl, dense, link, seed, name)
+        me, args.build, args.config_dir, tpl, kind, link, seed, name)
     two = ("%s%s --seed %d%s --out /tmp/%s.yaml && %s --scenario /tmp/%s.yaml --config-dir %s%s "
-           "--out /tmp/%s" % (gen, dense, seed, tpl, name, campaign.bin_path(args.build, "ofn_sim_runner"),
+           "--out /tmp/%s" % (gen, kind, seed, tpl, name, campaign.bin_path(args.build, "ofn_sim_runner"),
                               name, args.config_dir, " ".join([""] + runner_link_args(args, seed)),
                               name))
     return one, two
@@ -132,7 +134,7 @@ def runner_link_args(args, seed):
 
 
 def field_name(args, seed):
-    return ("dense-%d" if args.dense else "field-%d") % seed
+    return "%s-%d" % ({"fair": "field"}.get(args.kind, args.kind), seed)
 
 
 def envelope_excursions(failures):
@@ -167,7 +169,7 @@ def judge_field(r):
 def fly_field(args, seed, template):
     """Generate, fly and (if possible) baseline one field; tidy its folder."""
     field = os.path.join(args.out, "fields", field_name(args, seed) + ".yaml")
-    obstacles = random_field.write_field(seed, field, template, args.dense)
+    obstacles = random_field.write_field(seed, field, template, args.kind)
     run_dir = os.path.join(args.out, "runs", "seed-%d" % seed)
     rec = campaign.run_lockstep(args.build, field, run_dir, args.config_dir,
                                 extra_args=runner_link_args(args, seed))
@@ -190,8 +192,8 @@ def fly_field(args, seed, template):
     }
     out["ratio"] = cr.ratio_of(out["gate_to_gate_s"], out["baseline_time_s"])
     judge_field(out)
-    # A dense field fails on its verdict; a fair one on the flight alone, as always.
-    out["failed"] = not out["passed"] if args.dense else not out["success"]
+    # A dense or trap field fails on its verdict; a fair one on the flight alone, as always.
+    out["failed"] = not out["passed"] if args.judged else not out["success"]
     if not out["failed"] and not args.keep_all:
         shutil.rmtree(run_dir, ignore_errors=True)
         out["dir"] = None
@@ -234,6 +236,17 @@ DENSE_DESCRIPTION = (
     "true clearance below 0.8 R_s (clearance violation) or a speed, vertical speed, forward speed, "
     "commanded acceleration or controller command beyond its limit by more than 2 % (envelope "
     "excursion).")
+TRAP_DESCRIPTION = (
+    "Trap fields: each has one trap, drawn at random (a dead end of three thin walls open towards "
+    "the start, a wall across the course 500-1000 ft long with or without a gap, or a narrow deep "
+    "pocket; walls 60 % tall), 0-8 dense obstacles as clutter and, in a third of the fields, a "
+    "pop-up that appears while the vehicle cannot yet be near it (the rules are in "
+    "bench/random_field.py); max_time 300 s. A field may be sealed. Fields are judged as dense "
+    "ones: a field passes when it ends in success, or in a safe stop where the baseline finds no "
+    "route; it fails on a failure outcome, a safe stop although the baseline finds a route, a "
+    "clearance violation or an envelope excursion.")
+DESCRIPTIONS = {"fair": FAIR_DESCRIPTION, "dense": DENSE_DESCRIPTION, "trap": TRAP_DESCRIPTION}
+KIND_FLAGS = {"fair": "", "dense": " --dense", "trap": " --trap"}
 
 
 def write_report(args, runs, ctx):
@@ -250,7 +263,7 @@ def write_report(args, runs, ctx):
                  lines=[(cr.FAIL_LINE, "0.8 R_s (fail)", "red"), (1.0, "R_s", "orange")])
     t_ref = straight_time(ctx["template"])
     # Dense fields: the time ratio means something only for the flights that succeed.
-    timed = [r for r in runs if r["outcome"] == "success"] if args.dense else runs
+    timed = [r for r in runs if r["outcome"] == "success"] if args.judged else runs
     if have_baseline:
         ratios = [r["ratio"] for r in timed]
         popup_fields = [r["seed"] for r in runs if campaign.timed_obstacles(r["field"])]
@@ -272,14 +285,14 @@ def write_report(args, runs, ctx):
     finite = [v for v in ratios if v is not None]
     ratio_basis = "baseline" if have_baseline else "straight flight"
     lines = [
-        "# Monte Carlo: %s random obstacle fields" % ("dense" if args.dense else "fair"),
+        "# Monte Carlo: %s random obstacle fields" % args.kind,
         "",
         "- date: %s" % ctx["date"],
         "- machine: %d cores, %s" % (ctx["machine"]["cores"], ctx["machine"]["cpu"]),
         "- commit: %s" % ctx["commit"],
         "- binaries: %s/bin, configuration %s" % (args.build, args.config_dir),
         "- fields: seeds %s (bench/random_field.py%s, course from %s), %d flown %d at a time"
-        % (seeds_text(args.seeds), " --dense" if args.dense else "",
+        % (seeds_text(args.seeds), KIND_FLAGS[args.kind],
            os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
         "- link: %s" % ("between hosts (deploy/processes.yaml), %g %% of the datagrams lost, "
                          "every message %g +- %g s late, drawn from each field's seed"
@@ -290,7 +303,7 @@ def write_report(args, runs, ctx):
                                                   sum(r["wall_s"] for r in runs) / max(n, 1),
                                                   ctx["load"][0], ctx["load"][1]),
         "",
-        DENSE_DESCRIPTION if args.dense else FAIR_DESCRIPTION,
+        DESCRIPTIONS[args.kind],
         "",
         "## Result",
         "",
@@ -299,12 +312,12 @@ def write_report(args, runs, ctx):
         "| outcomes | %s |" % ", ".join("%s %d" % (o.replace("_", " "), outcomes[o]) for o in OUTCOMES),
     ]
     doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
-           "mode": "dense" if args.dense else "fair", "runs": n, "outcomes": outcomes,
+           "mode": args.kind, "runs": n, "outcomes": outcomes,
            "baselines_available": have_baseline, "wall_s": ctx["wall_s"], "load_average": ctx["load"],
            "seed_base": args.seed_base, "seeds": args.seeds, "link_loss": args.link_loss,
            "link_delay": args.link_delay, "link_jitter": args.link_jitter}
     clear_known = [c for c in clear if c is not None]
-    if args.dense:
+    if args.judged:
         routed = [r for r in runs if r["route"] is True]
         routed_ok = sum(1 for r in routed if r["outcome"] == "success")
         sealed = [r for r in runs if r["route"] is False]
@@ -372,7 +385,7 @@ def write_report(args, runs, ctx):
         for r in failed:
             one, two = rerun_commands(args, r["seed"])
             fig = " ([figure](failure-figures/%s))" % os.path.basename(r["figure"]) if r.get("figure") else ""
-            reasons = (r.get("why") or []) + r["failures"] if args.dense else r["failures"]
+            reasons = (r.get("why") or []) + r["failures"] if args.judged else r["failures"]
             lines.append("| %d | %d (%d) | %s | %s | %s / %s | %s | %s%s | `%s` <br> or `%s` |" % (
                 r["seed"], r["obstacles"], r["tall_obstacles"], r["outcome"].replace("_", " "),
                 {"ok": "route", "infeasible": "sealed"}.get(r["baseline_status"], r["baseline_status"]),
@@ -419,17 +432,18 @@ DEFAULT_RUNS = 300
 def build_parser():
     ap = cr.ArgumentParser(
         PROG, __doc__.splitlines()[0],
-        epilog="Field i is bench/random_field.py's field of seed S + i (fair, or dense with\n"
-               "--dense), flown in the lockstep runner; writes OUT/report.md, OUT/results.json,\n"
+        epilog="Field i is bench/random_field.py's field of seed S + i (fair, dense with\n"
+               "--dense, trap with --trap), flown in the lockstep runner; writes OUT/report.md, OUT/results.json,\n"
                "histograms and, for failed runs, a figure each.  The rules are in this\n"
                "file's docstring and in bench/random_field.py.\n"
                "\n"
                "Examples:\n"
                "  bench/monte_carlo.py --quick\n"
                "  bench/monte_carlo.py --dense --runs 50 --out /tmp/dense\n"
+               "  bench/monte_carlo.py --trap --runs 30 --out /tmp/trap\n"
                "  bench/monte_carlo.py --seeds 64,131,257 --keep-all\n"
                "\n"
-               "Exit codes: fair fields, 1 when the success rate is below %.0f %%; dense fields,\n"
+               "Exit codes: fair fields, 1 when the success rate is below %.0f %%; dense and trap fields,\n"
                "1 when any field fails; 2 for bad arguments, a missing build or a missing\n"
                "Python module (PyYAML, numpy, matplotlib).  The report is written either way."
                % (100 * SUCCESS_GOAL))
@@ -452,9 +466,13 @@ def build_parser():
     ap.add_argument("--template", default=random_field.DEFAULT_TEMPLATE, metavar="FILE",
                     help="scenario whose course the fields use (default: %s)"
                          % cr.rel(random_field.DEFAULT_TEMPLATE))
-    ap.add_argument("--dense", action="store_true",
-                    help="dense fields (10-25 obstacles, 15 ft gaps, may be sealed) instead of fair ones; "
-                    "exit code 1 when any field fails (default: fair fields)")
+    kind = ap.add_mutually_exclusive_group()
+    kind.add_argument("--dense", action="store_true",
+                      help="dense fields (10-25 obstacles, 15 ft gaps, may be sealed) instead of fair ones; "
+                      "exit code 1 when any field fails (default: fair fields)")
+    kind.add_argument("--trap", action="store_true",
+                      help="trap fields (a dead end, a wall wider than the map or a narrow pocket, clutter, "
+                      "sometimes a pop-up; may be sealed), judged as dense ones (default: fair fields)")
     ap.add_argument("--baseline-cache", metavar="DIR",
                     help="baseline cache folder (default: OUT/baselines)")
     ap.add_argument("--keep-failures", action="store_true",
@@ -475,6 +493,9 @@ def build_parser():
 def parse_args(argv):
     ap = build_parser()
     args = ap.parse_args(argv)
+    args.kind = random_field.field_kind(args)
+    # Dense and trap fields may be sealed: each is judged on its verdict.
+    args.judged = args.kind != "fair"
     if args.seeds is not None:
         try:
             args.seeds = [int(v) for v in args.seeds.split(",") if v.strip()]
@@ -541,7 +562,7 @@ def main(argv=None):
            "wall_s": time.monotonic() - t0, "load": (load_before, os.getloadavg()[0])}
     doc = write_report(args, runs, ctx)
     print("outcomes: %s" % ", ".join("%s %d" % (o, doc["outcomes"][o]) for o in OUTCOMES))
-    if args.dense:
+    if args.judged:
         print("fields with a route (baseline): %d, of which succeeded %d%s; sealed %d; no baseline verdict %d"
               % (doc["routed"], doc["routed_successes"],
                  "" if doc["routed_success_rate"] is None else " (%.1f %%)" % (100 * doc["routed_success_rate"]),
@@ -560,9 +581,9 @@ def main(argv=None):
             print("  failed: seed %d: %s, least clearance %s R_s (%s %s), max speed %s %s/s: %s" % (
                 r["seed"], r["outcome"], cr.fmt(r["min_clearance_over_rs"], 2), cr.fmt(r["min_clearance"]),
                 r["display_unit"], cr.fmt(r["max_speed"], 2), r["display_unit"],
-                "; ".join((r.get("why") or []) + r["failures"] if args.dense else r["failures"])))
+                "; ".join((r.get("why") or []) + r["failures"] if args.judged else r["failures"])))
     print("report: %s" % os.path.join(args.out, "report.md"))
-    if args.dense:
+    if args.judged:
         return 1 if doc["failed"] else 0
     return 0 if doc["success_rate"] >= SUCCESS_GOAL else 1
 

@@ -63,6 +63,32 @@ footprint sides 15..80 (yaw 0..180 deg) and cylinders of radius 8..30; 40 %
 of them are tall (top 250..300, to be passed beside) and the rest have a top
 anywhere in 40..250, low ones to climb over mixed with ones whose climb costs
 about as much as a detour.
+
+Trap fields (--trap). The shapes that catch a reactive planner, drawn at
+random: each field has one trap and some clutter, and a third of them a
+pop-up as well. Like dense fields they may be sealed (the baseline says).
+
+  T1. The trap, one of three kinds, equally likely:
+      - a dead end: a U of three thin walls (6..12 ft) open towards the
+        start, its axis turned up to 35 deg off the course, 50..160 ft wide
+        inside and 60..160 ft deep, its back wall at x = 200..330, up to
+        60 ft aside;
+      - a wall across the course wider than the map: 500..1000 ft long,
+        8..15 ft thick, turned up to 10 deg, at x = 150..300, in 70 % of
+        fields with one gap of 30..120 ft (narrower than 2 R_s in some)
+        within 200 ft of the course line;
+      - a pocket: a dead end 45..70 ft wide inside and 100..200 ft deep, a
+        corridor with little more than 2 R_s of room to back out of.
+      Walls are tall (top 250..300 ft) in 60 % of fields, else 100..240 ft.
+  T2. 0..8 clutter obstacles as dense ones (D3's 15 ft between any two,
+      trap walls included; a trap's own walls touch).
+  T3. A pop-up in a third of the fields: a box or cylinder as a dense one,
+      within 100 ft of the course line, that appears at a time at which no
+      vehicle within the speed limit can be nearer to it than R_s plus its
+      braking distance plus 30 ft (it is seen, not sprung).
+  Every obstacle keeps D2 (R_s + 30 from the start and the goal) and lies
+  within 40 <= x <= 380 (the run-up and run-out stay clear); the wall may
+  reach far beyond |y| = 160. max_time is 300 s (a wall's end may be far).
 """
 import math
 import os
@@ -100,6 +126,31 @@ DENSE_OTHER_TOP = (40.0, 250.0)
 DENSE_BOX_SIDE = (15.0, 80.0)
 DENSE_CYLINDER_RADIUS = (8.0, 30.0)
 DENSE_TRIES_PER_OBSTACLE = 200
+# Trap fields (rules T1..T3 above).
+TRAP_KINDS = ("dead_end", "wide_wall", "pocket")
+TRAP_TALL_SHARE = 0.6
+TRAP_TALL_TOP = (250.0, 300.0)
+TRAP_LOW_TOP = (100.0, 240.0)
+TRAP_MAX_TURN_DEG = 35.0
+TRAP_WALL_THICKNESS = (6.0, 12.0)
+TRAP_DEAD_END_WIDTH = (50.0, 160.0)
+TRAP_POCKET_WIDTH = (45.0, 70.0)
+TRAP_POCKET_DEPTH = (100.0, 200.0)
+TRAP_DEPTH = (60.0, 160.0)
+TRAP_BACK_X = (200.0, 330.0)
+TRAP_ASIDE = 60.0
+WIDE_WALL_LENGTH = (500.0, 1000.0)
+WIDE_WALL_THICKNESS = (8.0, 15.0)
+WIDE_WALL_TURN_DEG = 10.0
+WIDE_WALL_X = (150.0, 300.0)
+WIDE_WALL_GAP_SHARE = 0.7
+WIDE_WALL_GAP = (30.0, 120.0)
+WIDE_WALL_GAP_ASIDE = 200.0
+TRAP_CLUTTER = (0, 8)
+TRAP_POPUP_SHARE = 1.0 / 3.0
+TRAP_POPUP_Y_MAX = 100.0
+TRAP_POPUP_MARGIN = 30.0  # ft beyond R_s and the braking distance
+TRAP_MAX_TIME = 300.0  # s
 CIRCLE_SEGMENTS = 48  # cylinders as polygons for the plan distances; error < 0.3 % of the radius
 MAX_DRAWS = 10000
 
@@ -357,6 +408,139 @@ def generate_dense(seed, tpl):
     raise RuntimeError("seed %d: no dense field in %d draws" % (seed, MAX_DRAWS))
 
 
+def _wall(a, b, thickness, height):
+    """A thin box from plan point a to plan point b (ft)."""
+    length = math.hypot(b[0] - a[0], b[1] - a[1])
+    return _rounded({"kind": "box", "center": [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
+                     "size": [length, thickness],
+                     "yaw_deg": math.degrees(math.atan2(b[1] - a[1], b[0] - a[0])) % 180.0,
+                     "height": height})
+
+
+def _trap_walls(rng, kind):
+    """The trap's walls (T1), before the placement rules are checked."""
+    height = rng.uniform(*(TRAP_TALL_TOP if rng.random() < TRAP_TALL_SHARE else TRAP_LOW_TOP))
+    if kind == "wide_wall":
+        length = rng.uniform(*WIDE_WALL_LENGTH)
+        thickness = rng.uniform(*WIDE_WALL_THICKNESS)
+        turn = math.radians(rng.uniform(-WIDE_WALL_TURN_DEG, WIDE_WALL_TURN_DEG))
+        cx, cy = rng.uniform(*WIDE_WALL_X), rng.uniform(-0.5 * length, 0.5 * length) * 0.5
+        # Along the wall: (-sin, cos) turned from +y.
+        ux, uy = -math.sin(turn), math.cos(turn)
+        ends = (-0.5 * length, 0.5 * length)
+        pieces = [ends]
+        if rng.random() < WIDE_WALL_GAP_SHARE:
+            gap = rng.uniform(*WIDE_WALL_GAP)
+            # The gap's middle within WIDE_WALL_GAP_ASIDE of the course line (y = 0).
+            mid = rng.uniform(-WIDE_WALL_GAP_ASIDE, WIDE_WALL_GAP_ASIDE) - cy / uy
+            mid = min(max(mid, ends[0] + gap), ends[1] - gap)
+            pieces = [(ends[0], mid - 0.5 * gap), (mid + 0.5 * gap, ends[1])]
+        walls = [_wall((cx + ux * lo, cy + uy * lo), (cx + ux * hi, cy + uy * hi), thickness, height)
+                 for lo, hi in pieces]
+    else:
+        pocket = kind == "pocket"
+        width = rng.uniform(*(TRAP_POCKET_WIDTH if pocket else TRAP_DEAD_END_WIDTH))
+        depth = rng.uniform(*(TRAP_POCKET_DEPTH if pocket else TRAP_DEPTH))
+        thickness = rng.uniform(*TRAP_WALL_THICKNESS)
+        turn = math.radians(rng.uniform(-TRAP_MAX_TURN_DEG, TRAP_MAX_TURN_DEG))
+        bx, by = rng.uniform(*TRAP_BACK_X), rng.uniform(-TRAP_ASIDE, TRAP_ASIDE)
+        fx, fy = math.cos(turn), math.sin(turn)  # into the trap, towards its back wall
+        sx, sy = -fy, fx  # across it
+        half = 0.5 * (width + thickness)
+        back_l = (bx + sx * half, by + sy * half)
+        back_r = (bx - sx * half, by - sy * half)
+        mouth_l = (back_l[0] - fx * depth, back_l[1] - fy * depth)
+        mouth_r = (back_r[0] - fx * depth, back_r[1] - fy * depth)
+        # The back wall reaches the side walls' outer faces: the corners are closed.
+        ext = 0.5 * thickness
+        walls = [_wall((back_l[0] + sx * ext, back_l[1] + sy * ext),
+                       (back_r[0] - sx * ext, back_r[1] - sy * ext), thickness, height),
+                 _wall(mouth_l, back_l, thickness, height), _wall(mouth_r, back_r, thickness, height)]
+    return walls
+
+
+def _popup_fair(ob, tpl):
+    """The latest appear time (s) at which no vehicle within the speed limit
+    since the start can be nearer to `ob` than R_s, its braking distance and
+    TRAP_POPUP_MARGIN (T3); negative when there is none."""
+    lim = tpl["limits"]
+    speed = float(lim["max_speed"])
+    braking = speed * speed / (2.0 * float(lim["max_accel"]))
+    start = tpl["start"]["position"][:2]
+    reach = point_distance(start, footprint(ob, circumscribed=True))
+    return (reach - float(lim.get("clearance", 0.0)) - braking - TRAP_POPUP_MARGIN) / speed
+
+
+def trap_rule_violations(obstacles, n_walls, tpl):
+    """Every broken trap-field rule, as text: D2 and the x band for all,
+    D3 between any two obstacles that are not both walls of the trap."""
+    rs = float(tpl["limits"].get("clearance", 0.0))
+    start = tpl["start"]["position"][:2]
+    goal = tpl["waypoints"][-1]["position"][:2]
+    shapes = [footprint(ob, circumscribed=True) for ob in obstacles]
+    out = []
+    for i, (ob, poly) in enumerate(zip(obstacles, shapes)):
+        xs = [x for x, _ in poly]
+        if min(xs) < DENSE_X_MIN or max(xs) > DENSE_X_MAX:
+            out.append("obstacle %d outside %g <= x <= %g" % (i + 1, DENSE_X_MIN, DENSE_X_MAX))
+        for name, pt in (("start", start), ("goal", goal)):
+            if point_distance(pt, poly) < rs + END_MARGIN_BEYOND_RS:
+                out.append("obstacle %d within R_s + %g of the %s" % (i + 1, END_MARGIN_BEYOND_RS, name))
+        for j in range(max(i, 0)):
+            if i < n_walls and j < n_walls:
+                continue
+            centres = math.hypot(ob["center"][0] - obstacles[j]["center"][0],
+                                 ob["center"][1] - obstacles[j]["center"][1])
+            if centres - _bounding_radius(ob) - _bounding_radius(obstacles[j]) >= DENSE_MIN_GAP:
+                continue
+            d = plan_distance(poly, shapes[j])
+            if d < DENSE_MIN_GAP:
+                out.append("obstacles %d and %d %.1f apart (< %.1f)" % (j + 1, i + 1, d, DENSE_MIN_GAP))
+    return out
+
+
+def generate_trap(seed, tpl):
+    """(obstacles, draws): a trap field (T1..T3), a function of the seed and the template only.
+
+    The trap is drawn until its walls keep the rules; clutter obstacles and
+    the pop-up are then placed one by one, each redrawn until the field
+    keeps them (a clutter obstacle that finds no place within its tries is
+    left out, so a field may hold fewer than drawn).
+    """
+    rng = random.Random(seed)
+    draws = 0
+    kind = TRAP_KINDS[rng.randrange(len(TRAP_KINDS))]
+    while True:
+        draws += 1
+        if draws > MAX_DRAWS:
+            raise RuntimeError("seed %d: no trap field in %d draws" % (seed, MAX_DRAWS))
+        walls = _trap_walls(rng, kind)
+        if not trap_rule_violations(walls, len(walls), tpl):
+            break
+    for w in walls:
+        w["trap"] = kind
+    obstacles = list(walls)
+    for _ in range(rng.randint(*TRAP_CLUTTER)):
+        for _ in range(DENSE_TRIES_PER_OBSTACLE):
+            draws += 1
+            ob = _draw_dense_obstacle(rng)
+            if not trap_rule_violations(obstacles + [ob], len(walls), tpl):
+                obstacles.append(ob)
+                break
+    if rng.random() < TRAP_POPUP_SHARE:
+        for _ in range(DENSE_TRIES_PER_OBSTACLE):
+            draws += 1
+            ob = _draw_dense_obstacle(rng)
+            ob["center"][1] = round(rng.uniform(-TRAP_POPUP_Y_MAX, TRAP_POPUP_Y_MAX), 1)
+            latest = _popup_fair(ob, tpl)
+            if latest < 1.0 or trap_rule_violations(obstacles + [ob], len(walls), tpl):
+                continue
+            ob["appear_time"] = round(rng.uniform(1.0, latest), 1)
+            obstacles.append(ob)
+            break
+    return obstacles, draws
+
+
 def _num(v):
     return ("%.1f" % v).rstrip("0").rstrip(".") if v != int(v) else "%d" % int(v)
 
@@ -365,11 +549,23 @@ def _vec(v):
     return "[" + ", ".join(_num(float(x)) for x in v) + "]"
 
 
-def field_yaml(seed, obstacles, tpl, template_name, dense=False):
-    """Scenario text in the bench file layout."""
+def field_yaml(seed, obstacles, tpl, template_name, kind="fair"):
+    """Scenario text in the bench file layout; `kind` is fair, dense or trap."""
     start, lim, gates = tpl["start"], tpl["limits"], tpl["gates"]
     tall = sum(1 for o in obstacles if is_tall(o))
-    if dense:
+    if kind == "trap":
+        trap = next((o["trap"] for o in obstacles if "trap" in o), "none")
+        popups = sum(1 for o in obstacles if "appear_time" in o)
+        head = [
+            "# Trap field, seed %d (bench/random_field.py --trap; course from %s)." % (seed, template_name),
+            "# A %s, clutter%s; a route need not exist." % (trap.replace("_", " "),
+                                                            " and a pop-up" if popups else ""),
+            "# Regenerate: bench/random_field.py --trap --seed %d --out FILE" % seed,
+            "name: trap-%d" % seed,
+            "description: trap field %d, a %s and %d more obstacles, may be sealed"
+            % (seed, trap.replace("_", " "), sum(1 for o in obstacles if "trap" not in o)),
+        ]
+    elif kind == "dense":
         head = [
             "# Dense random obstacle field, seed %d (bench/random_field.py --dense; course from %s)."
             % (seed, template_name),
@@ -420,16 +616,23 @@ def field_yaml(seed, obstacles, tpl, template_name, dense=False):
             lines.append("    radius: %s" % _num(ob["radius"]))
         lines.append("    height: %s%s" % (_num(ob["height"]), "   # tall: pass beside" if is_tall(ob)
                                           else "   # low: may climb over"))
-    if "max_time" in tpl:
+        if "appear_time" in ob:
+            lines.append("    appear_time: %s   # s; seen before it can be reached" % _num(ob["appear_time"]))
+    if kind == "trap":
+        lines.append("max_time: %s" % _num(TRAP_MAX_TIME))
+    elif "max_time" in tpl:
         lines.append("max_time: %s" % _num(float(tpl["max_time"])))
     return "\n".join(lines) + "\n"
 
 
-def write_field(seed, path, template=DEFAULT_TEMPLATE, dense=False):
-    """Write the field of `seed` (fair, or dense with `dense`) to `path`; returns its obstacle list."""
+GENERATORS = {"fair": generate, "dense": generate_dense, "trap": generate_trap}
+
+
+def write_field(seed, path, template=DEFAULT_TEMPLATE, kind="fair"):
+    """Write the field of `seed` of `kind` (fair, dense or trap) to `path`; returns its obstacle list."""
     tpl = load_template(template)
-    obstacles, _ = (generate_dense if dense else generate)(seed, tpl)
-    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO), dense)
+    obstacles, _ = GENERATORS[kind](seed, tpl)
+    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO), kind)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w") as f:
         f.write(text)
@@ -442,12 +645,13 @@ PROG = "bench/random_field.py"
 def build_parser():
     ap = cr.ArgumentParser(
         PROG, __doc__.splitlines()[0],
-        epilog="The rules of both classes of field are in this file's docstring.\n"
+        epilog="The rules of the three classes of field are in this file's docstring.\n"
                "\n"
                "Examples:\n"
                "  bench/random_field.py --seed 7 --out /tmp/field-7.yaml\n"
                "  bench/random_field.py --dense --seed 7 --template sim/scenarios/bench1.yaml \\\n"
                "      --out /tmp/dense-7.yaml\n"
+               "  bench/random_field.py --trap --seed 7 --out /tmp/trap-7.yaml\n"
                "\n"
                "Exit codes: 0 when the field is written; 2 for bad arguments, an unusable\n"
                "template, a file that cannot be written or PyYAML missing.")
@@ -457,16 +661,25 @@ def build_parser():
     ap.add_argument("--template", default=DEFAULT_TEMPLATE, metavar="FILE",
                     help="scenario whose course (start, waypoints, limits, gates) is used "
                          "(default: %s)" % cr.rel(DEFAULT_TEMPLATE))
-    ap.add_argument("--dense", action="store_true",
-                    help="a dense field (10-25 obstacles, 15 ft gaps, may be sealed) instead of "
-                         "a fair one (default: fair)")
+    kind = ap.add_mutually_exclusive_group()
+    kind.add_argument("--dense", action="store_true",
+                      help="a dense field (10-25 obstacles, 15 ft gaps, may be sealed) instead of "
+                           "a fair one (default: fair)")
+    kind.add_argument("--trap", action="store_true",
+                      help="a trap field (a dead end, a wall wider than the map or a narrow "
+                           "pocket, clutter, sometimes a pop-up; may be sealed) (default: fair)")
     return ap
+
+
+def field_kind(args):
+    """fair, dense or trap, from --dense / --trap."""
+    return "trap" if getattr(args, "trap", False) else "dense" if args.dense else "fair"
 
 
 def main(argv=None):
     args = build_parser().parse_args(argv)
     try:
-        obstacles = write_field(args.seed, args.out, args.template, args.dense)
+        obstacles = write_field(args.seed, args.out, args.template, field_kind(args))
     except OSError as exc:
         print("%s: error: %s: %s" % (PROG, exc.filename or args.out, exc.strerror), file=sys.stderr)
         return cr.EXIT_USAGE
