@@ -397,8 +397,8 @@ def write_report(out, ctx):
         "",
         "Lockstep runner (all services in one process, deterministic), %d at a time; the machine's "
         "1-minute load average was %.1f before and %.1f after the lockstep part (other work on the "
-        "machine lengthens the wall times; it changes a result only if it pushes RH solves past "
-        "their wall-time cap)." % (ctx["jobs"], ctx["load"]["before"], ctx["load"]["after"]),
+        "machine lengthens the wall times only: in lockstep an RH solve is bounded by its "
+        "evaluation count, not by wall time, so the results repeat to the bit)." % (ctx["jobs"], ctx["load"]["before"], ctx["load"]["after"]),
         "",
         cr.course_table(rows + ([mp_row] if mp_row else []), unit),
         "",

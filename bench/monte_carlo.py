@@ -376,8 +376,8 @@ def write_report(args, runs, ctx):
     else:
         unit = next((r["display_unit"] for r in failed if r.get("display_unit")), "ft")
         lines += ["Folders kept in `runs/` (LCM log %s). Each command flies that field again, alone; "
-                  "the lockstep runner is deterministic given the field, up to the RH optimiser's "
-                  "wall-time cap per solve, which a busy machine can reach."
+                  "the lockstep runner is deterministic given the field, whatever the machine's load "
+                  "(an RH solve there is bounded by its evaluation count, not by wall time)."
                   % ("kept" if args.keep_failures or args.keep_all else "deleted; --keep-failures keeps it"),
                   "", "| seed | obstacles (tall) | outcome | baseline | least clearance (%s) / R_s "
                   "| max speed (%s/s) | reason | re-run alone |" % (unit, unit),
