@@ -10,31 +10,9 @@
 #include <mutex>
 #include <string>
 
+#include "ofn/common/time.hpp"
+
 namespace ofn {
-
-/// Microseconds since the Unix epoch (wall) or since simulation start (sim).
-using Utime = int64_t;
-
-constexpr Utime kMicrosPerSecond = 1000000;
-inline double to_seconds(Utime t) {
-  return static_cast<double>(t) * 1e-6;
-}
-inline Utime to_utime(double seconds) {
-  return static_cast<Utime>(seconds * 1e6 + (seconds >= 0 ? 0.5 : -0.5));
-}
-
-class Clock {
- public:
-  virtual ~Clock() = default;
-  virtual Utime now() const = 0;
-  /// False until the clock has a time (a SIM_CLOCK-following clock before its
-  /// first message).
-  virtual bool valid() const { return true; }
-  /// Wall seconds that pass per clock second; the process loop uses it to
-  /// sleep until the next timer. Zero means "time only advances on messages".
-  virtual double wall_seconds_per_clock_second() const { return 1.0; }
-  virtual std::string describe() const = 0;
-};
 
 /// The system clock: field deployment.
 class WallClock final : public Clock {

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "ofn/common/envelope.hpp"
-#include "ofn/common/scenario.hpp"
+#include "ofn/common/mission_types.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 
 namespace ofn::control {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "ofn/common/frames.hpp"
-#include "ofn/common/scenario.hpp"
+#include "ofn/common/mission_types.hpp"
 
 namespace ofn::control {
 

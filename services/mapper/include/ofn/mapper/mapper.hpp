@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "ofn/common/clock.hpp"
+#include "ofn/common/time.hpp"
 #include "ofn/common/frames.hpp"
 #include "ofn/mapper/cuboid_extractor.hpp"
 #include "ofn/mapper/hit_spread.hpp"

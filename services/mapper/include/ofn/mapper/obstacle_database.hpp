@@ -11,7 +11,7 @@
 #include <functional>
 #include <vector>
 
-#include "ofn/common/clock.hpp"
+#include "ofn/common/time.hpp"
 #include "ofn/mapper/cuboid_extractor.hpp"
 
 namespace ofn::mapping {

@@ -27,7 +27,7 @@
 
 #include "ofn/common/braking.hpp"
 #include "ofn/common/bspline.hpp"
-#include "ofn/common/scenario.hpp"
+#include "ofn/common/mission_types.hpp"
 #include "ofn/rh_optimizer/rh_optimizer.hpp"
 
 namespace ofn::rh {

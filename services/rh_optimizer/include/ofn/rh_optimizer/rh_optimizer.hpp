@@ -27,7 +27,7 @@
 
 #include "ofn/common/bspline.hpp"
 #include "ofn/common/frames.hpp"
-#include "ofn/common/scenario.hpp"
+#include "ofn/common/mission_types.hpp"
 #include "ofn/map/distance_field.hpp"
 
 namespace ofn::rh {

@@ -6,7 +6,7 @@
 #include <deque>
 #include <optional>
 
-#include "ofn/common/clock.hpp"
+#include "ofn/common/time.hpp"
 #include "ofn/common/frames.hpp"
 
 namespace ofn::sensing {

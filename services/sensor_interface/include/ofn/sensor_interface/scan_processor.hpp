@@ -12,7 +12,7 @@
 #include <optional>
 #include <vector>
 
-#include "ofn/common/clock.hpp"
+#include "ofn/common/time.hpp"
 #include "ofn/common/frames.hpp"
 #include "ofn/common/lidar_geometry.hpp"
 #include "ofn/sensor_interface/pose_buffer.hpp"

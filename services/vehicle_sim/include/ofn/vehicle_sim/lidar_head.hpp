@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "ofn/common/clock.hpp"
+#include "ofn/common/time.hpp"
 #include "ofn/common/frames.hpp"
 #include "ofn/common/lidar_geometry.hpp"
 #include "ofn/world/world.hpp"

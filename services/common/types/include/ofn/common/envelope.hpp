@@ -11,7 +11,7 @@
 #include <limits>
 
 #include "ofn/common/frames.hpp"
-#include "ofn/common/scenario.hpp"
+#include "ofn/common/mission_types.hpp"
 
 namespace ofn {
 

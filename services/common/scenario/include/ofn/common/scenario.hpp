@@ -10,17 +10,9 @@
 #include <vector>
 
 #include "ofn/common/frames.hpp"
+#include "ofn/common/mission_types.hpp"
 
 namespace ofn {
-
-struct Limits {
-  double max_speed = 0;           // m/s
-  double max_accel = 0;           // m/s^2, total
-  double max_vertical_speed = 0;  // m/s
-  double min_forward_speed = 0;   // m/s
-  double clearance = 0;           // m
-  double sensor_range = 0;        // m
-};
 
 /// One obstacle of the course, SI and world NED. Boxes stand on the ground
 /// and may be yawed; cylinders and trees are vertical.
@@ -43,29 +35,6 @@ struct ObstacleSpec {
     return (appear_time < 0 || t >= appear_time) && (disappear_time < 0 || t < disappear_time);
   }
 };
-
-struct Waypoint {
-  Vec3 position = Vec3::Zero();  // m, world NED
-  double capture_radius = 0;     // m
-};
-
-/// Index of the waypoint that ends the leg nearest `position` (ties go to
-/// the later leg); 0 for a single waypoint, -1 for none. Where a plan is
-/// picked up mid-route (a restarted controller, the planners).
-inline int nearest_leg(const std::vector<Waypoint>& waypoints, const Vec3& position) {
-  if (waypoints.empty()) return -1;
-  int best = 0;
-  double best_distance = std::numeric_limits<double>::infinity();
-  for (size_t i = 1; i < waypoints.size(); ++i) {
-    const double d =
-        distance_to_segment(position, waypoints[i - 1].position, waypoints[i].position);
-    if (d <= best_distance) {
-      best_distance = d;
-      best = static_cast<int>(i);
-    }
-  }
-  return best;
-}
 
 /// The airframe as flown, relative to the model the controller assumes
 /// (vehicle_sim's configured airframe), and its actuator authority. The
