@@ -14,6 +14,7 @@
 #include "ofn/common/clock.hpp"
 #include "ofn/common/logging.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/common/validate/global_path.hpp"
 #include "ofn/global_planner/global_planner_service.hpp"
 #include "service_test_bus.hpp"
 

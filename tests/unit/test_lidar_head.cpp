@@ -14,6 +14,7 @@
 #include "ofn/common/logging.hpp"
 #include "ofn/common/obstacle_messages.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/common/validate/lidar_scan.hpp"
 #include "ofn/lidar_scan_t.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/vehicle_sim/lidar_head.hpp"

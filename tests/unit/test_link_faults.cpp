@@ -18,6 +18,7 @@
 #include "ofn/common/clock.hpp"
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/common/validate/nav_state.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/sim/link_faults.hpp"
 

@@ -14,6 +14,8 @@
 
 #include "ofn/common/clock.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/common/validate/heartbeat.hpp"
+#include "ofn/common/validate/nav_state.hpp"
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/scan_world_t.hpp"

@@ -16,6 +16,7 @@
 #include "ofn/common/channels.hpp"
 #include "ofn/common/config.hpp"
 #include "ofn/common/logging.hpp"
+#include "ofn/common/validate/virtual_obstacles.hpp"
 #include "ofn/obstacle_injector/obstacle_injector_service.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/virtual_obstacles_t.hpp"

@@ -11,7 +11,7 @@
 #include "ofn/common/config.hpp"
 #include "ofn/common/logging.hpp"
 #include "ofn/common/sim_clock_guard.hpp"
-#include "ofn/sim_clock_t.hpp"
+#include "ofn/common/validate/sim_clock.hpp"
 
 namespace ofn {
 namespace {

@@ -7,6 +7,11 @@
 #include "ofn/common/message_names.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
+#include "ofn/common/validate/lidar_scan.hpp"
+#include "ofn/common/validate/mission.hpp"
+#include "ofn/common/validate/nav_state.hpp"
+#include "ofn/common/validate/ref_traj.hpp"
+#include "ofn/common/validate/solver_stats.hpp"
 #include "ofn/control_status_t.hpp"
 
 namespace ofn::control {

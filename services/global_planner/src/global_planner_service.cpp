@@ -5,6 +5,10 @@
 #include <limits>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/validate/cuboid_list.hpp"
+#include "ofn/common/validate/mission.hpp"
+#include "ofn/common/validate/narrow_passages.hpp"
+#include "ofn/common/validate/nav_state.hpp"
 
 namespace ofn::planning {
 namespace {

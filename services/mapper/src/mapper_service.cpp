@@ -3,6 +3,8 @@
 #include <algorithm>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/validate/nav_state.hpp"
+#include "ofn/common/validate/scan_world.hpp"
 
 namespace ofn::mapping {
 

@@ -8,8 +8,13 @@
 #include <fmt/format.h>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/message_checks.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
-#include "ofn/common/validate.hpp"
+#include "ofn/common/validate/global_path.hpp"
+#include "ofn/common/validate/mission.hpp"
+#include "ofn/common/validate/nav_state.hpp"
+#include "ofn/common/validate/obstacle_grid.hpp"
+#include "ofn/common/validate/scan_world.hpp"
 
 namespace ofn::rh {
 namespace {

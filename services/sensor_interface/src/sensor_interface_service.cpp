@@ -4,6 +4,8 @@
 #include <string>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/validate/lidar_scan.hpp"
+#include "ofn/common/validate/nav_state.hpp"
 
 namespace ofn::sensing {
 namespace {

@@ -5,8 +5,12 @@
 #include <vector>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/message_checks.hpp"
 #include "ofn/common/message_names.hpp"
 #include "ofn/common/obstacle_messages.hpp"
+#include "ofn/common/validate/actuator_cmd.hpp"
+#include "ofn/common/validate/control_status.hpp"
+#include "ofn/common/validate/virtual_obstacles.hpp"
 #include "ofn/lidar_scan_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/sim_clock_t.hpp"

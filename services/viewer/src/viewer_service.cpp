@@ -1,6 +1,16 @@
 #include "ofn/viewer/viewer_service.hpp"
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/validate/control_status.hpp"
+#include "ofn/common/validate/cuboid_list.hpp"
+#include "ofn/common/validate/global_path.hpp"
+#include "ofn/common/validate/mission.hpp"
+#include "ofn/common/validate/narrow_passages.hpp"
+#include "ofn/common/validate/nav_state.hpp"
+#include "ofn/common/validate/obstacle_grid.hpp"
+#include "ofn/common/validate/ref_traj.hpp"
+#include "ofn/common/validate/solver_stats.hpp"
+#include "ofn/common/validate/virtual_obstacles.hpp"
 
 namespace ofn::viewer {
 

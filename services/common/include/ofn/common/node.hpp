@@ -18,7 +18,6 @@
 #include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/link_model.hpp"
-#include "ofn/common/validate.hpp"
 
 namespace ofn {
 
@@ -67,7 +66,8 @@ class Node {
   Utime now() const { return clock_.now(); }
 
   /// Subscribes `handler` to `channel`. Every message is decoded, checked by
-  /// validate(Msg) and for staleness; a bad one is counted, logged (rate
+  /// validate(Msg) (the caller includes ofn/common/validate/<message>.hpp
+  /// of each type it subscribes to) and for staleness; a bad one is counted, logged (rate
   /// limited) and dropped, and the handler never sees it.
   template <class Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&)> handler,

@@ -8,6 +8,7 @@
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/control_status_t.hpp"
 #include "ofn/controller/command_gate.hpp"
 #include "ofn/controller/heading_reference.hpp"
 #include "ofn/controller/neural_adaptation.hpp"

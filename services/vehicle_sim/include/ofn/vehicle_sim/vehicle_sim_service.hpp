@@ -9,9 +9,11 @@
 #include <optional>
 #include <string>
 
+#include "ofn/actuator_cmd_t.hpp"
 #include "ofn/common/config.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/scenario.hpp"
+#include "ofn/control_status_t.hpp"
 #include "ofn/vehicle_sim/checkpoint.hpp"
 #include "ofn/vehicle_sim/disturbances.hpp"
 #include "ofn/vehicle_sim/lidar_head.hpp"
