@@ -356,16 +356,21 @@ def dense_rule_violations(obstacles, tpl):
         for name, pt in (("start", start), ("goal", goal)):
             if point_distance(pt, poly) < rs + END_MARGIN_BEYOND_RS:
                 out.append("obstacle %d within R_s + %g of the %s" % (i + 1, END_MARGIN_BEYOND_RS, name))
-        for j in range(i):
-            other = obstacles[j]
-            centres = math.hypot(ob["center"][0] - other["center"][0], ob["center"][1] - other["center"][1])
-            # Bounding circles far enough apart settle it without the polygons.
-            if centres - _bounding_radius(ob) - _bounding_radius(other) >= DENSE_MIN_GAP:
-                continue
-            d = plan_distance(poly, shapes[j])
-            if d < DENSE_MIN_GAP:
-                out.append("obstacles %d and %d %.1f apart (< %.1f)" % (j + 1, i + 1, d, DENSE_MIN_GAP))
+        out += [v for v in (_dense_gap_violation(obstacles, shapes, i, j) for j in range(i)) if v]
     return out
+
+
+def _dense_gap_violation(obstacles, shapes, i, j):
+    """D3 between obstacles i and j (outlines `shapes`), as text; None when kept."""
+    ob, other = obstacles[i], obstacles[j]
+    centres = math.hypot(ob["center"][0] - other["center"][0], ob["center"][1] - other["center"][1])
+    # Bounding circles far enough apart settle it without the polygons.
+    if centres - _bounding_radius(ob) - _bounding_radius(other) >= DENSE_MIN_GAP:
+        return None
+    d = plan_distance(shapes[i], shapes[j])
+    if d < DENSE_MIN_GAP:
+        return "obstacles %d and %d %.1f apart (< %.1f)" % (j + 1, i + 1, d, DENSE_MIN_GAP)
+    return None
 
 
 def _draw_dense_obstacle(rng):
@@ -486,16 +491,9 @@ def trap_rule_violations(obstacles, n_walls, tpl):
         for name, pt in (("start", start), ("goal", goal)):
             if point_distance(pt, poly) < rs + END_MARGIN_BEYOND_RS:
                 out.append("obstacle %d within R_s + %g of the %s" % (i + 1, END_MARGIN_BEYOND_RS, name))
-        for j in range(max(i, 0)):
-            if i < n_walls and j < n_walls:
-                continue
-            centres = math.hypot(ob["center"][0] - obstacles[j]["center"][0],
-                                 ob["center"][1] - obstacles[j]["center"][1])
-            if centres - _bounding_radius(ob) - _bounding_radius(obstacles[j]) >= DENSE_MIN_GAP:
-                continue
-            d = plan_distance(poly, shapes[j])
-            if d < DENSE_MIN_GAP:
-                out.append("obstacles %d and %d %.1f apart (< %.1f)" % (j + 1, i + 1, d, DENSE_MIN_GAP))
+        # A trap's own walls touch at its corners.
+        others = range(n_walls if i < n_walls else 0, i)
+        out += [v for v in (_dense_gap_violation(obstacles, shapes, i, j) for j in others) if v]
     return out
 
 
