@@ -13,8 +13,18 @@
 #include "ofn/common/validate/ref_traj.hpp"
 #include "ofn/common/validate/solver_stats.hpp"
 #include "ofn/control_status_t.hpp"
+#include "ofn/controller/reference_source.hpp"
 
 namespace ofn::control {
+
+// The mode machine's modes are CONTROL_STATUS's values.
+static_assert(static_cast<int8_t>(ControlMode::kHold) == control_status_t::HOLD);
+static_assert(static_cast<int8_t>(ControlMode::kWaypoint) == control_status_t::WAYPOINT);
+static_assert(static_cast<int8_t>(ControlMode::kTrajectory) == control_status_t::TRAJECTORY);
+static_assert(static_cast<int8_t>(ControlMode::kNavStale) == control_status_t::NAV_STALE);
+static_assert(static_cast<int8_t>(ControlMode::kDone) == control_status_t::DONE);
+static_assert(static_cast<int8_t>(ControlMode::kSafeStop) == control_status_t::SAFE_STOP);
+
 namespace {
 
 /// A look-around hover (either way round): the controller turns the heading.
@@ -468,81 +478,89 @@ void ControllerService::control_step() {
   if (ref_traj_ && now - ref_traj_->utime <= to_utime(config_.ref_traj_timeout))
     traj_ref = sample_ref_traj(*ref_traj_, now);
 
+  // Whether the planner's word or its map is stale, and why (for the log);
+  // at the last waypoint it no longer matters.
+  const auto blind =
+      previous == control_status_t::DONE ? std::nullopt : perception_.stale(to_seconds(now));
+  StepSituation situation;
+  situation.previous = static_cast<ControlMode>(previous);
+  situation.has_mission = guidance_.has_mission();
+  situation.mission_arrived = mission_arrived;
+  situation.lapsed = lapsed;
+  situation.reference_flown = last_ref_flown_;
+  situation.awaiting_planner = !perception_.confirmed_once() && perception_.settings().enabled;
+  situation.fresh_plan = traj_ref.has_value();
+  situation.avoiding = selector_.avoiding();
+  situation.map_stale = blind.has_value();
+  situation.stopping = selector_.stopping();
+  const ReferenceChoice choice = choose_reference(situation);
+  mode_ = static_cast<int8_t>(choice.mode);
+
   Reference ref;
   // The horizontal direction to face, if there is one.
   std::optional<Vec3> facing;
-  if (!guidance_.has_mission() ||
-      (!perception_.confirmed_once() && perception_.settings().enabled && !traj_ref &&
-       (previous == control_status_t::HOLD || previous == control_status_t::NAV_STALE))) {
-    // No mission, or a mission but not yet the planner's word on the way:
-    // the flight has not begun, the hold goes on.
-    if (guidance_.has_mission() && previous != control_status_t::HOLD)
-      node_.log().info("holding for the planner's first status");
-    ref = selector_.hold(to_seconds(now), x.position, x.velocity,
-                         previous != control_status_t::HOLD || mission_arrived || lapsed);
-    mode_ = control_status_t::HOLD;
-  } else if (traj_ref) {
-    mode_ = control_status_t::TRAJECTORY;
-    ref = *traj_ref;
-    if (looks_around(*ref_traj_)) {
-      facing =
-          look_around_facing(path_heading_.yaw(), ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
-    } else {
-      // Where the plan will be look_ahead seconds on (or at its end).
-      std::optional<Vec3> ahead;
-      if (config_.heading.look_ahead > 0 && !ref_traj_->sample_time.empty()) {
-        const Utime end = ref_traj_->t0_utime + to_utime(ref_traj_->sample_time.back());
-        const auto later =
-            sample_ref_traj(*ref_traj_, std::min(end, now + to_utime(config_.heading.look_ahead)));
-        if (later) ahead = later->position;
+  switch (choice.source) {
+    case ReferenceSource::kHold:
+      // No mission, or a mission but not yet the planner's word on the way:
+      // the flight has not begun, the hold goes on.
+      if (guidance_.has_mission() && previous != control_status_t::HOLD)
+        node_.log().info("holding for the planner's first status");
+      ref = selector_.hold(to_seconds(now), x.position, x.velocity, choice.hold_begins);
+      break;
+    case ReferenceSource::kPlan:
+      ref = *traj_ref;
+      if (looks_around(*ref_traj_)) {
+        facing = look_around_facing(path_heading_.yaw(),
+                                    ref_traj_->mode == ref_traj_t::LOOK_AROUND_LEFT);
+      } else {
+        // Where the plan will be look_ahead seconds on (or at its end).
+        std::optional<Vec3> ahead;
+        if (config_.heading.look_ahead > 0 && !ref_traj_->sample_time.empty()) {
+          const Utime end = ref_traj_->t0_utime + to_utime(ref_traj_->sample_time.back());
+          const auto later = sample_ref_traj(
+              *ref_traj_, std::min(end, now + to_utime(config_.heading.look_ahead)));
+          if (later) ahead = later->position;
+        }
+        facing = facing_ahead(ref.position, ref.velocity, ahead, config_.heading.min_speed);
       }
-      facing = facing_ahead(ref.position, ref.velocity, ahead, config_.heading.min_speed);
+      break;
+    case ReferenceSource::kPlanStop:
+      if (!selector_.stopping())
+        node_.log().warn("avoidance plan stale at t={:.2f} s: flying its stop", to_seconds(now));
+      ref = selector_.safe_stop(to_seconds(now), last_ref_flown_ ? last_ref_ : vehicle_state(x),
+                                mission_->limits.max_accel);
+      facing = facing_along(ref.velocity, config_.heading.min_speed);
+      break;
+    case ReferenceSource::kBlindStop:
+      // Guidance flies the leg without a map: not while nobody has checked
+      // it against a fresh one. The stop from the reference flown, then the
+      // hover, until the planner's word is fresh again.
+      if (!selector_.stopping())
+        node_.log().warn("guidance holds at t={:.2f} s: {}: flying a stop", to_seconds(now),
+                         *blind);
+      ref = selector_.safe_stop(to_seconds(now),
+                                choice.stop_from_vehicle ? vehicle_state(x) : last_ref_,
+                                mission_->limits.max_accel);
+      facing = facing_along(ref.velocity, config_.heading.min_speed);
+      break;
+    case ReferenceSource::kGuidance: {
+      if (choice.end_stop) {
+        selector_.end_stop();
+        node_.log().info("guidance resumes at t={:.2f} s: the planner's map is fresh again",
+                         to_seconds(now));
+      }
+      if (choice.resync_guidance) guidance_.resync(x.position, x.velocity);
+      const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
+      active_waypoint_ = g.active_waypoint;
+      ref.position = g.position;
+      ref.velocity = g.velocity;
+      ref.acceleration = g.acceleration;
+      facing = facing_along(g.leg_direction, kMinLegHorizontal);
+      if (g.done) mode_ = control_status_t::DONE;
+      break;
     }
-  } else if (selector_.avoiding()) {
-    // The plan went stale mid-avoidance: its stop, then the hover.
-    if (!selector_.stopping())
-      node_.log().warn("avoidance plan stale at t={:.2f} s: flying its stop", to_seconds(now));
-    mode_ = control_status_t::SAFE_STOP;
-    ref = selector_.safe_stop(to_seconds(now), last_ref_flown_ ? last_ref_ : vehicle_state(x),
-                              mission_->limits.max_accel);
-    facing = facing_along(ref.velocity, config_.heading.min_speed);
-  } else if (const auto blind = previous == control_status_t::DONE
-                                    ? std::nullopt
-                                    : perception_.stale(to_seconds(now))) {
-    // Guidance flies the leg without a map: not while nobody has checked
-    // it against a fresh one. The stop from the reference flown, then the
-    // hover, until the planner's word is fresh again.
-    if (!selector_.stopping())
-      node_.log().warn("guidance holds at t={:.2f} s: {}: flying a stop", to_seconds(now), *blind);
-    mode_ = control_status_t::SAFE_STOP;
-    // From the reference flown, or, with none flown since navigation
-    // returned or the mission arrived, from the vehicle's own state.
-    const Reference from =
-        previous == control_status_t::NAV_STALE || !last_ref_flown_ ? vehicle_state(x) : last_ref_;
-    ref = selector_.safe_stop(to_seconds(now), from, mission_->limits.max_accel);
-    facing = facing_along(ref.velocity, config_.heading.min_speed);
-  } else {
-    if (selector_.stopping()) {
-      selector_.end_stop();
-      node_.log().info("guidance resumes at t={:.2f} s: the planner's map is fresh again",
-                       to_seconds(now));
-    }
-    // Guidance resumes from the vehicle after any other reference: a plan,
-    // a stop, or the hold flown while the planner's first word was awaited
-    // (guidance was anchored when the mission came, and the vehicle has
-    // flown the hold's stop since).
-    if (previous == control_status_t::TRAJECTORY || previous == control_status_t::SAFE_STOP ||
-        previous == control_status_t::HOLD)
-      guidance_.resync(x.position, x.velocity);
-    const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
-    active_waypoint_ = g.active_waypoint;
-    ref.position = g.position;
-    ref.velocity = g.velocity;
-    ref.acceleration = g.acceleration;
-    facing = facing_along(g.leg_direction, kMinLegHorizontal);
-    mode_ = g.done ? control_status_t::DONE : control_status_t::WAYPOINT;
   }
-  if (previous == control_status_t::HOLD && mode_ != control_status_t::HOLD) controller_.reset();
+  if (choice.reset_control) controller_.reset();
   if (mode_ != previous)
     node_.log().info("mode {} -> {} at t={:.2f} s", control_mode_name(previous),
                      control_mode_name(mode_), to_seconds(now));
