@@ -14,6 +14,7 @@
 #include "ofn/common/config.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/controller/controller_service.hpp"
+#include "ofn/rh_optimizer/rh_optimizer_service.hpp"
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
 
 namespace ofn {
@@ -312,6 +313,23 @@ TEST(ControllerConfig, ShippedNominalAirframeIsTheShippedSimulatedOne) {
   auto empty = YamlReader::empty("(defaults)");
   EXPECT_EQ(every_parameter(control::load_controller_config(empty).nominal),
             every_parameter(vehicle::RotorcraftParams{}));
+}
+
+TEST(RhOptimizerConfig, ShippedCommitWindowCoversWhatTheControllerFliesAlone) {
+  // The controller flies a plan until ref_traj_timeout after its stamp and
+  // then that plan's stop; the optimiser checks the stop from every instant
+  // of commit_time after the stamp. The window must hold the timeout, one
+  // control period, and the lag of the controller's clock behind the
+  // optimiser's (two SIM_CLOCK followers over a delayed link).
+  auto controller_reader =
+      YamlReader::load_file(std::string(OFN_SOURCE_DIR) + "/config/controller.yaml");
+  auto optimiser_reader =
+      YamlReader::load_file(std::string(OFN_SOURCE_DIR) + "/config/rh_optimizer.yaml");
+  const auto controller = control::load_controller_config(controller_reader);
+  const auto optimiser = rh::load_rh_optimizer_config(optimiser_reader);
+  const double control_period = 1.0 / controller.rate;
+  constexpr double kClockLag = 0.1;  // s
+  EXPECT_GE(optimiser.commit.commit_time, controller.ref_traj_timeout + control_period + kClockLag);
 }
 
 TEST_F(ConfigFiles, ControllerConfigReadsTheNominalAirframe) {
