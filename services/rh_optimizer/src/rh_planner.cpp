@@ -323,13 +323,24 @@ StepOutput RhPlanner::step(const StepInput& input) {
     // A warm solve that failed, or whose plan has no safe stop: once more
     // from the route.
     out.report = optimizer_.solve(problem, cold_guess());
-    out.solves = 2;
+    ++out.solves;
     accepted = committable(out.report);
+  }
+  if (!accepted && fallback_.hover_retry && !input.global_path.empty() &&
+      problem.velocity.norm() < fallback_.hover_retry_speed) {
+    // The route's guess failed (warm, then cold, or cold alone) from a
+    // hover: once more from the straight one (FallbackSettings::hover_retry).
+    SolveReport straight = optimizer_.solve(problem, RhOptimizer::guess_straight(problem));
+    ++out.solves;
+    if (committable(straight)) {
+      out.report = std::move(straight);
+      accepted = true;
+    }
   }
   if (accepted && guess.warm && fallback_.stall_retry &&
       plan_stalled(out.report.trajectory, problem)) {
     SolveReport cold = optimizer_.solve(problem, cold_guess());
-    out.solves = 2;
+    ++out.solves;
     out.stalled = true;
     const CommitCheck warm_check = out.commit;
     if (cold.cost < out.report.cost && committable(cold)) {

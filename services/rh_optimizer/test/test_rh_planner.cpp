@@ -124,6 +124,48 @@ TEST(RhPlanner, AShortStopFromAHoverIsSolvedColdAndMovesOffInTime) {
   }
 }
 
+TEST(RhPlanner, FromAHoverAFailedRouteGuessIsTriedStraight) {
+  // A hover 5 m before a stop (an escape leg's end), on a route whose first
+  // corner lies 5 mm below the vehicle, as on dense seed 142 (the vehicle
+  // had settled a few millimetres off the point the escape began at): no
+  // feasible point is found from the route's guess. At rest, every step
+  // would pose the same problem and fail the same way; from the straight
+  // guess, millimetres away, it solves. (Which guesses fail turns on
+  // details: here a column stands 4 m to the side.)
+  const ClearanceQuery column = field_with({{-2, 0, 4, 6, 60.0f}});
+  auto hover_input = [&]() {
+    StepInput in = input_at(Vec3(0, 0, -kAltitude), 0.0, column);
+    in.problem.velocity = Vec3::Zero();
+    in.problem.target = in.problem.position + Vec3(5, 0, 0);
+    in.problem.terminal_x = in.problem.frame.to_guidance(in.problem.target).x();
+    in.problem.stop_at_target = true;
+    in.global_path = {Vec3(0, 0, -kAltitude), Vec3(0, 0, -kAltitude + 0.005),
+                      Vec3(5, 0, -kAltitude)};
+    return in;
+  };
+  FallbackSettings without;
+  without.hover_retry = false;
+  without.short_retry = false;
+  RhPlanner route_only(untimed(), without);
+  const StepOutput failed = route_only.step(hover_input());
+  ASSERT_NE(failed.mode, StepMode::kSolved) << "the route's guess solved: the case is gone";
+
+  FallbackSettings with = without;
+  with.hover_retry = true;
+  RhPlanner planner(untimed(), with);
+  const StepOutput out = planner.step(hover_input());
+  ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
+  EXPECT_EQ(out.solves, 2);
+  const double T = out.trajectory.duration();
+  EXPECT_LT((out.trajectory.position(T) - hover_input().problem.target).norm(), 0.05);
+
+  // Moving, the next step poses another problem: no retry.
+  StepInput moving = hover_input();
+  moving.problem.velocity = Vec3(0.5, 0, 0);
+  RhPlanner moving_planner(untimed(), with);
+  EXPECT_EQ(moving_planner.step(moving).solves, 1);
+}
+
 TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
   // From a hover, the plan moves off at once, so the stall retry stays out
   // of the way: one solve per step.

@@ -22,6 +22,13 @@ struct FallbackSettings {
   bool cold_retry = true;               // after a failed warm solve, try once from the path
   bool stall_retry = true;  // a stalled warm plan: also solve from the path, fly the cheaper
   bool short_retry = true;  // before a stop (no plan, none to keep): once more to a nearer x
+  /// From a hover, a failed solve from the route: once more from the
+  /// straight guess. At rest the next step poses the same problem, so a
+  /// solve that fails fails again at every step; SLSQP's failure can turn
+  /// on millimetres of the guess (dense seed 142: a 4.3 m escape leg failed
+  /// from the route's guess 5 mm off the straight one, which solved).
+  bool hover_retry = true;
+  double hover_retry_speed = 0.3;     // m/s: a start this slow counts as a hover
   double short_retry_fraction = 0.5;  // of the way from the vehicle to the terminal x
   double climb_fraction = 0.8;  // of the vertical speed and acceleration limits a climb flies at
   // A climb starts only from a hover this still (the commit gate's start tolerances).
