@@ -15,6 +15,7 @@
 #include "ofn/common/validate/nav_state.hpp"
 #include "ofn/common/validate/obstacle_grid.hpp"
 #include "ofn/common/validate/scan_world.hpp"
+#include "ofn/rh_optimizer/start_state.hpp"
 
 namespace ofn::rh {
 namespace {
@@ -657,39 +658,20 @@ void RhOptimizerService::tick() {
   StepInput in;
   RhProblem& p = in.problem;
   p.frame = GuidanceFrame::from_leg(leg.from, leg.to);
-  p.position = position;
-  p.velocity = velocity;
-  // a(t0) is fixed by construction (Eq. 5) and not constrained, so what it
-  // is set to is what the trajectory starts with. The measured acceleration
-  // carries the scanner's yaw-sweep oscillation and gust noise; the planned
-  // one (or zero, as waypoint guidance commands in cruise, when avoidance
-  // has just engaged) is what the controller was following.
-  std::optional<double> since_plan;
-  if (!last_trajectory_.empty()) {
-    const double since = to_seconds(now - last_trajectory_t0_);
-    if (since >= 0 && since <= last_trajectory_.duration()) since_plan = since;
-  }
-  bool from_plan = false;
-  if (config_.planned_initial_state && since_plan) {
-    const Vec3 planned_position = last_trajectory_.position(*since_plan);
-    const Vec3 planned_velocity = last_trajectory_.velocity(*since_plan);
-    if ((planned_position - position).norm() <= config_.replan_position_error &&
-        (planned_velocity - velocity).norm() <= config_.replan_velocity_error) {
-      p.position = planned_position;
-      p.velocity = planned_velocity;
-      p.acceleration = last_trajectory_.acceleration(*since_plan);
-      from_plan = true;
-    }
-  }
-  if (!from_plan) {
-    if (config_.planned_initial_acceleration) {
-      p.acceleration = since_plan ? last_trajectory_.acceleration(*since_plan) : Vec3::Zero();
-    } else {
-      p.acceleration = to_vec3(nav_->acceleration);
-      const double norm = p.acceleration.norm();
-      if (norm > mission_->limits.max_accel) p.acceleration *= mission_->limits.max_accel / norm;
-    }
-  }
+  // On the last plan while the vehicle is near it, else at the measured
+  // state (start_state.hpp).
+  StartStateSettings start_rules;
+  start_rules.planned_initial_state = config_.planned_initial_state;
+  start_rules.replan_position_error = config_.replan_position_error;
+  start_rules.replan_velocity_error = config_.replan_velocity_error;
+  start_rules.planned_initial_acceleration = config_.planned_initial_acceleration;
+  const StartState start =
+      choose_start_state(last_trajectory_, to_seconds(now - last_trajectory_t0_),
+                         MeasuredState{position, velocity, to_vec3(nav_->acceleration)},
+                         mission_->limits.max_accel, start_rules);
+  p.position = start.position;
+  p.velocity = start.velocity;
+  p.acceleration = start.acceleration;
   p.target = leg.to;
   const double x_target = p.frame.to_guidance(leg.to).x();
   const double min_horizon = std::min(limits.sensor_range, 4.0 * limits.clearance);
