@@ -4,7 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include "ofn/common/braking.hpp"
+
 namespace ofn::rh {
+
+bool defer_first_brake(double conflict_distance, const Vec3& velocity, double deceleration,
+                       double margin) {
+  return conflict_distance > stop_from(Vec3::Zero(), velocity, deceleration).distance() + margin;
+}
 
 double cross_track_distance(const Leg& leg, const Vec3& position) {
   const Vec3 d = leg.to - leg.from;

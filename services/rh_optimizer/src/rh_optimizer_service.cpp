@@ -762,16 +762,15 @@ void RhOptimizerService::tick() {
   // engagement has published anything. Once a plan or a stop has been
   // flown, the controller holds to it (and to its stop) and a silence
   // would only leave it hovering.
-  if (out.mode == StepMode::kBraking && last_trajectory_.empty()) {
-    const double brake = config_.fallback.braking_accel_fraction * limits.max_accel;
-    const double braking_distance = stop_from(Vec3::Zero(), velocity, brake).distance();
-    if (nominal.conflict_distance > braking_distance + config_.defer_margin) {
-      note("avoidance deferred: no trajectory yet");
-      return publish_stats(now, solver_stats_t::DEFERRED,
-                           "no avoidance trajectory yet (" + out.reason +
-                               "); conflict still far, nominal guidance continues",
-                           &out.report, true);
-    }
+  if (out.mode == StepMode::kBraking && last_trajectory_.empty() &&
+      defer_first_brake(nominal.conflict_distance, velocity,
+                        config_.fallback.braking_accel_fraction * limits.max_accel,
+                        config_.defer_margin)) {
+    note("avoidance deferred: no trajectory yet");
+    return publish_stats(now, solver_stats_t::DEFERRED,
+                         "no avoidance trajectory yet (" + out.reason +
+                             "); conflict still far, nominal guidance continues",
+                         &out.report, true);
   }
   const Utime t0 = to_utime(out.start_time);
   const int8_t mode =

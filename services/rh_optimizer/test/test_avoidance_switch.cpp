@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "ofn/common/braking.hpp"
 #include "ofn/rh_optimizer/avoidance_switch.hpp"
 
 namespace ofn::rh {
@@ -115,6 +116,22 @@ TEST(AvoidanceSwitch, StoppingAtTheLastWaypointHandsBackOnlyWhenSlow) {
   EXPECT_TRUE(sw.update(3.0, false, 0.0, 0.31));
   // Nearly at rest on the waypoint: hands back.
   EXPECT_FALSE(sw.update(3.5, false, 0.0, 0.2));
+}
+
+TEST(DeferFirstBrake, OnlyWhileTheConflictIsBeyondTheStopAndTheMargin) {
+  // At 3 m/s braking at 0.39 m/s^2 the stop (onset and ease-out included)
+  // takes about 12.3 m; with a 10 m margin a conflict 30 m on is deferred,
+  // one 20 m on is braked for.
+  const Vec3 cruise(3.0, 0, 0);
+  const double stop = stop_from(Vec3::Zero(), cruise, 0.39).distance();
+  ASSERT_GT(stop, 11.0);
+  ASSERT_LT(stop, 14.0);
+  EXPECT_TRUE(defer_first_brake(30.0, cruise, 0.39, 10.0));
+  EXPECT_FALSE(defer_first_brake(20.0, cruise, 0.39, 10.0));
+  EXPECT_FALSE(defer_first_brake(stop + 10.0, cruise, 0.39, 10.0));  // the bound itself brakes
+  // From a hover only the margin counts.
+  EXPECT_TRUE(defer_first_brake(10.5, Vec3::Zero(), 0.39, 10.0));
+  EXPECT_FALSE(defer_first_brake(9.5, Vec3::Zero(), 0.39, 10.0));
 }
 
 }  // namespace

@@ -61,6 +61,14 @@ double terminal_x(const GuidanceFrame& frame, const mapping::Heightfield& grid,
                   const Vec3& position, double sensor_range, double beyond, double x_max,
                   double min_horizon);
 
+/// Before an engagement has published anything, a step that can only
+/// brake is deferred (nominal guidance flies on, and the next step tries
+/// again, typically with the global route the new obstacle is about to
+/// produce) while the conflict lies farther along the nominal path than the
+/// stop from `velocity` at `deceleration` (braking.hpp) plus `margin` (m).
+bool defer_first_brake(double conflict_distance, const Vec3& velocity, double deceleration,
+                       double margin);
+
 class AvoidanceSwitch {
  public:
   explicit AvoidanceSwitch(SwitchSettings settings = {}) : settings_(settings) {}
