@@ -168,6 +168,25 @@ class TrajectoryController {
   const AdaptiveElement& adaptive() const { return *adaptive_; }
 
  private:
+  // step() in stages, as the loops are drawn: each reads and writes the
+  // step's signals and fills its part of the output.
+  struct StepSignals;
+  /// Outer loop: reference model, PID and adaptive share -> the governed,
+  /// bounded acceleration command (out->commanded_accel).
+  void outer_loop(const Reference& ref, const VehicleEstimate& x, StepSignals& s,
+                  ControlOutput* out);
+  /// The thrust vector for that acceleration -> thrust, attitude command
+  /// and collective.
+  void invert_for_thrust(double yaw, StepSignals& s, ControlOutput* out) const;
+  /// Inner loop: reference model, PID and adaptive share -> angular
+  /// acceleration, inverted through the nominal rotor to cyclic and pedal.
+  void inner_loop(double yaw_rate, const VehicleEstimate& x, StepSignals& s, ControlOutput* out);
+  void clamp_to_actuator_limits(ControlOutput* out) const;
+  /// Pseudo-control hedging: commanded less what the nominal model says
+  /// these controls achieve (servo rates, flapping lag, the reference
+  /// attitude rather than the commanded one).
+  void hedge(const Vec3& body_rates, const StepSignals& s, ControlOutput* out);
+  void advance_reference_models(const StepSignals& s, ControlOutput* out);
   double collective_for_thrust(double thrust, const Vec3& air_body) const;
   /// `accel` with the speed governor applied at `velocity`.
   Vec3 govern_speed(const Vec3& accel, const Vec3& velocity) const;
