@@ -877,6 +877,209 @@ def unique_log_stem(log_dir):
     return candidate
 
 
+class Supervisor:
+    """Starts the services in table order, restarts one that exits (with a
+    back-off, within --max-restarts, the budget given back after
+    --healthy-after seconds up) and decides when the run ends: a signal, the
+    run limit, an ends_run service's exit, a configuration error, or no
+    service left. Sets end_reason and exit_code when it does."""
+
+    def __init__(self, services, env, console, state, max_restarts, healthy_after, timeout):
+        self.services = services
+        self.env = env
+        self.say = console.say
+        self.state = state
+        self.max_restarts = max_restarts
+        self.healthy_after = healthy_after
+        self.timeout = timeout  # s, for the message when the run limit ends the run
+        self.end_reason = None
+        self.exit_code = 0
+
+    def start_all(self):
+        for child in self.services:
+            if self.state.stop_signal is not None:
+                return
+            if not child.start(self.env) and self._ends(self.handle_exit(child, time.monotonic())):
+                return
+
+    def poll(self, now, deadline):
+        """One look at the run: signals, the run limit, each child's exit or
+        due restart. Returns True when the run has ended."""
+        if self.state.stop_signal is not None:
+            self.end_reason = "received %s; stopping" % signal.Signals(self.state.stop_signal).name
+            self.exit_code = 128 + self.state.stop_signal
+            return True
+        if deadline is not None and now >= deadline:
+            self.end_reason = "run limit of %s s reached; stopping (exit code %d)" % (
+                format_number(self.timeout), EXIT_TIMEOUT)
+            self.exit_code = EXIT_TIMEOUT
+            return True
+        for child in self.services:
+            outcome = None
+            if child.state == Child.RUNNING:
+                self.reset_if_healthy(child, now)
+            if child.state == Child.RUNNING and not child.alive():
+                outcome = self.handle_exit(child, now)
+            elif child.state == Child.WAITING and now >= child.restart_at:
+                child.restart_at = None
+                if not child.start(self.env):
+                    outcome = self.handle_exit(child, now)
+            if self._ends(outcome):
+                return True
+        return False
+
+    def all_done(self):
+        """True (and the run ended) when no service is left running or waiting."""
+        if not all(c.state == Child.DONE for c in self.services):
+            return False
+        self.end_reason = "no service left running; stopping"
+        failed = any((describe_exit(c.last_returncode)[0] or 0) != 0 or c.proc is None
+                     for c in self.services)
+        self.exit_code = 1 if failed else 0
+        return True
+
+    def _ends(self, outcome):
+        if outcome is None:
+            return False
+        self.end_reason, self.exit_code = outcome
+        return True
+
+    def reset_if_healthy(self, child, now):
+        """A service up --healthy-after seconds since its last restart gets
+        its restart budget back."""
+        if (child.restarts and self.healthy_after > 0 and child.started_at is not None
+                and now - child.started_at >= self.healthy_after):
+            self.say("%s has run %s s since its last restart; restart count reset (0/%d)"
+                     % (child.name, format_number(self.healthy_after), self.max_restarts))
+            child.restarts = 0
+
+    def handle_exit(self, child, now):
+        """Decide what a child's exit means; returns (end_reason, exit_code) or None."""
+        if child.proc is None:
+            code, text = 127, "failed to start"
+        else:
+            child.finish_output()
+            child.last_returncode = child.proc.returncode
+            code, text = describe_exit(child.proc.returncode)
+        if code == EXIT_SERVICE_CONFIG_ERROR:
+            # Restarting cannot fix a configuration or usage error, and
+            # the flight cannot go on without the service: stop now.
+            child.state = Child.DONE
+            return ("%s %s, a configuration or usage error (see its output above); "
+                    "not restarted: ending the run (exit code %d)"
+                    % (child.name, text, EXIT_BAD_INPUT)), EXIT_BAD_INPUT
+        if child.spec.ends_run:
+            child.state = Child.DONE
+            return "%s %s; it ends the run" % (child.name, text), code
+        if not child.spec.restart:
+            child.state = Child.DONE
+            self.say("%s %s; not restarted (restart: false)" % (child.name, text))
+        elif child.restarts >= self.max_restarts:
+            child.state = Child.DONE
+            child.gave_up = True
+            self.say("%s %s; GIVING UP after %d restart%s (--max-restarts %d)"
+                     % (child.name, text, child.restarts, "" if child.restarts == 1 else "s",
+                        self.max_restarts))
+        else:
+            child.restarts += 1
+            child.total_restarts += 1
+            delay = min(BACKOFF_START_S * 2 ** (child.restarts - 1), BACKOFF_CAP_S)
+            child.state = Child.WAITING
+            child.restart_at = now + delay
+            self.say("%s %s; restarting in %g s (restart %d/%d)"
+                     % (child.name, text, delay, child.restarts, self.max_restarts))
+        return None
+
+
+def check_inputs(args, table_path, scenario, values):
+    """Everything checked once, before anything starts: the table, the
+    selection, the scenario, each service's files, the keyring, lcm-logger.
+    Returns (specs, lcm-logger path or None); raises TableError."""
+    table = load_table(table_path)
+    specs = select_processes(table, args.only, args.host)
+    check_yaml_file(scenario, "--scenario", allow_empty=False)
+    check_files(table, specs, values)
+    if values["bus_keys"]:
+        check_keyring(values["bus_keys"], specs)
+    logger_exe = None
+    if not args.no_record:
+        logger_exe = shutil.which("lcm-logger")
+        if logger_exe is None:
+            raise TableError("lcm-logger not found (apt-get install liblcm-bin), or pass --no-record")
+    return specs, logger_exe
+
+
+def install_signal_handlers(state):
+    def on_signal(signum, _frame):
+        if state.stopping:
+            # Second Ctrl-C during shutdown: do not wait out the grace period.
+            state.force_kill = True
+        elif state.stop_signal is None:
+            state.stop_signal = signum
+
+    # SIGHUP too: a dropped ssh session must stop the run cleanly (children
+    # live in their own sessions and would not see the hangup).
+    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(signum, on_signal)
+
+
+def child_prefixes():
+    """(orphan guard, line buffering) argv prefixes, each empty when its tool is missing."""
+    # If the launcher itself is killed (SIGKILL, OOM) its children must not
+    # fly on as orphans: have the kernel send them SIGTERM.
+    setpriv = shutil.which("setpriv")
+    orphan_guard = [setpriv, "--pdeathsig", "TERM"] if setpriv else []
+    # Services write to a pipe, where C stdio would buffer whole blocks and
+    # hold back crash context; stdbuf makes their output line-buffered.
+    stdbuf = shutil.which("stdbuf")
+    line_buffered = [stdbuf, "-oL", "-eL"] if stdbuf else []
+    return orphan_guard, line_buffered
+
+
+def logger_child(logger_exe, lcm_url, lcm_log, service_log_dir, orphan_guard, console):
+    # lcm-logger prints a throughput summary every second; keep those in its
+    # log file so they do not drown the services' output.
+    return Child("lcm-logger", orphan_guard + [logger_exe, "--lcm-url=" + lcm_url, lcm_log],
+                 os.path.join(service_log_dir, "lcm-logger.log"), console,
+                 file_only=re.compile(rb"^Summary: "))
+
+
+def start_logger(logger, lcm_log, log_dir, console, env):
+    """True when lcm-logger started and is still alive after settling
+    (latest_log then names its log); False, having said why, when not."""
+    if not logger.start(env):
+        return False
+    time.sleep(LOGGER_SETTLE_S)
+    if not logger.alive():
+        logger.finish_output()
+        console.say("lcm-logger %s; cannot record the flight (check the LCM URL and that "
+                    "multicast is routed, or use --no-record)" % describe_exit(logger.proc.returncode)[1])
+        return False
+    console.say("recording LCM traffic to %s" % lcm_log)
+    with open(os.path.join(log_dir, "latest_log"), "w") as f:
+        f.write(lcm_log + "\n")
+    return True
+
+
+def watch_run(supervisor, deadline, resources, logger, say):
+    """Polls until the supervisor ends the run: samples each service's
+    memory and CPU, and warns once if lcm-logger dies."""
+    logger_warned = False
+    while supervisor.end_reason is None:
+        now = time.monotonic()
+        if supervisor.poll(now, deadline):
+            return
+        resources.sample(supervisor.services, now)
+        if logger is not None and not logger_warned and not logger.alive():
+            logger.finish_output()
+            say("WARNING: lcm-logger %s; the rest of this flight is NOT being recorded"
+                % describe_exit(logger.proc.returncode)[1])
+            logger_warned = True
+        if supervisor.all_done():
+            return
+        time.sleep(POLL_INTERVAL_S)
+
+
 def main(argv=None):
     args = parse_args(argv)
 
@@ -900,19 +1103,8 @@ def main(argv=None):
         "bus_keys": os.path.abspath(os.path.expanduser(args.bus_keys)) if args.bus_keys else "",
     }
 
-    # Everything is checked once, before anything starts.
     try:
-        table = load_table(table_path)
-        specs = select_processes(table, args.only, args.host)
-        check_yaml_file(scenario, "--scenario", allow_empty=False)
-        check_files(table, specs, values)
-        if values["bus_keys"]:
-            check_keyring(values["bus_keys"], specs)
-        logger_exe = None
-        if not args.no_record:
-            logger_exe = shutil.which("lcm-logger")
-            if logger_exe is None:
-                raise TableError("lcm-logger not found (apt-get install liblcm-bin), or pass --no-record")
+        specs, logger_exe = check_inputs(args, table_path, scenario, values)
     except TableError as e:
         sys.stderr.write("launch.py: error: %s\n" % e)
         return EXIT_BAD_INPUT
@@ -926,31 +1118,12 @@ def main(argv=None):
 
     console = Console(max(len(name) for name in [s.name for s in specs] + ["lcm-logger"]))
     state = RunState()
-
-    def on_signal(signum, _frame):
-        if state.stopping:
-            # Second Ctrl-C during shutdown: do not wait out the grace period.
-            state.force_kill = True
-        elif state.stop_signal is None:
-            state.stop_signal = signum
-
-    # SIGHUP too: a dropped ssh session must stop the run cleanly (children
-    # live in their own sessions and would not see the hangup).
-    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-        signal.signal(signum, on_signal)
+    install_signal_handlers(state)
 
     env = dict(os.environ)
     env["LCM_DEFAULT_URL"] = args.lcm_url   # services that take no --lcm-url use the same bus
     env["PYTHONUNBUFFERED"] = "1"
-
-    # Services write to a pipe, where C stdio would buffer whole blocks and
-    # hold back crash context; stdbuf makes their output line-buffered.
-    stdbuf = shutil.which("stdbuf")
-    line_buffered = [stdbuf, "-oL", "-eL"] if stdbuf else []
-    # If the launcher itself is killed (SIGKILL, OOM) its children must not
-    # fly on as orphans: have the kernel send them SIGTERM.
-    setpriv = shutil.which("setpriv")
-    orphan_guard = [setpriv, "--pdeathsig", "TERM"] if setpriv else []
+    orphan_guard, line_buffered = child_prefixes()
 
     say, note = console.say, console.note
     say("table %s, %d process%s: %s" % (_display_path(table_path), len(specs),
@@ -960,7 +1133,7 @@ def main(argv=None):
         scenario, values["rtf"], args.lcm_url,
         "authenticated (keyring %s)" % values["bus_keys"] if values["bus_keys"] else "open"))
     pinning = Pinning(not args.no_pin, note)
-    if not stdbuf:
+    if not line_buffered:
         note("stdbuf not found; service output may arrive in blocks")
 
     services = []
@@ -985,135 +1158,25 @@ def main(argv=None):
         note("no ends_run process selected; the run ends at the time limit or on Ctrl-C")
 
     logger = None
+    lcm_log = os.path.join(log_dir, stem + ".lcm")
     resources = None
-    exit_code = 0
+    supervisor = Supervisor(services, env, console, state, args.max_restarts, args.healthy_after,
+                            args.timeout)
     try:
         if logger_exe is not None:
-            lcm_log = os.path.join(log_dir, stem + ".lcm")
-            # lcm-logger prints a throughput summary every second; keep those
-            # in its log file so they do not drown the services' output.
-            logger = Child("lcm-logger", orphan_guard + [logger_exe, "--lcm-url=" + args.lcm_url, lcm_log],
-                           os.path.join(service_log_dir, "lcm-logger.log"), console,
-                           file_only=re.compile(rb"^Summary: "))
-            if not logger.start(env):
+            logger = logger_child(logger_exe, args.lcm_url, lcm_log, service_log_dir, orphan_guard,
+                                  console)
+            if not start_logger(logger, lcm_log, log_dir, console, env):
                 return EXIT_LAUNCHER_FAILURE
-            time.sleep(LOGGER_SETTLE_S)
-            if not logger.alive():
-                logger.finish_output()
-                say("lcm-logger %s; cannot record the flight (check the LCM URL and that "
-                    "multicast is routed, or use --no-record)" % describe_exit(logger.proc.returncode)[1])
-                return EXIT_LAUNCHER_FAILURE
-            say("recording LCM traffic to %s" % lcm_log)
-            with open(os.path.join(log_dir, "latest_log"), "w") as f:
-                f.write(lcm_log + "\n")
         else:
             note("not recording LCM traffic (--no-record)")
         say("service logs in %s/" % service_log_dir)
         resources = ResourceWatch(os.path.join(service_log_dir, "resources.csv"))
 
-        def reset_if_healthy(child, now):
-            """A service up --healthy-after seconds since its last restart gets
-            its restart budget back."""
-            if (child.restarts and args.healthy_after > 0 and child.started_at is not None
-                    and now - child.started_at >= args.healthy_after):
-                say("%s has run %s s since its last restart; restart count reset (0/%d)"
-                    % (child.name, format_number(args.healthy_after), args.max_restarts))
-                child.restarts = 0
-
-        def handle_exit(child, now):
-            """Decide what a child's exit means; returns (end_reason, exit_code) or None."""
-            if child.proc is None:
-                code, text = 127, "failed to start"
-            else:
-                child.finish_output()
-                child.last_returncode = child.proc.returncode
-                code, text = describe_exit(child.proc.returncode)
-            if code == EXIT_SERVICE_CONFIG_ERROR:
-                # Restarting cannot fix a configuration or usage error, and
-                # the flight cannot go on without the service: stop now.
-                child.state = Child.DONE
-                return ("%s %s, a configuration or usage error (see its output above); "
-                        "not restarted: ending the run (exit code %d)"
-                        % (child.name, text, EXIT_BAD_INPUT)), EXIT_BAD_INPUT
-            if child.spec.ends_run:
-                child.state = Child.DONE
-                return "%s %s; it ends the run" % (child.name, text), code
-            if not child.spec.restart:
-                child.state = Child.DONE
-                say("%s %s; not restarted (restart: false)" % (child.name, text))
-            elif child.restarts >= args.max_restarts:
-                child.state = Child.DONE
-                child.gave_up = True
-                say("%s %s; GIVING UP after %d restart%s (--max-restarts %d)"
-                    % (child.name, text, child.restarts, "" if child.restarts == 1 else "s",
-                       args.max_restarts))
-            else:
-                child.restarts += 1
-                child.total_restarts += 1
-                delay = min(BACKOFF_START_S * 2 ** (child.restarts - 1), BACKOFF_CAP_S)
-                child.state = Child.WAITING
-                child.restart_at = now + delay
-                say("%s %s; restarting in %g s (restart %d/%d)"
-                    % (child.name, text, delay, child.restarts, args.max_restarts))
-            return None
-
-        end_reason = None
-        for child in services:
-            if state.stop_signal is not None:
-                break
-            if not child.start(env):
-                outcome = handle_exit(child, time.monotonic())
-                if outcome is not None:
-                    end_reason, exit_code = outcome
-                    break
+        supervisor.start_all()
         deadline = time.monotonic() + run_limit if run_limit is not None else None
-
-        logger_warned = False
-        while end_reason is None:
-            if state.stop_signal is not None:
-                end_reason = "received %s; stopping" % signal.Signals(state.stop_signal).name
-                exit_code = 128 + state.stop_signal
-                break
-            now = time.monotonic()
-            if deadline is not None and now >= deadline:
-                end_reason = "run limit of %s s reached; stopping (exit code %d)" % (
-                    format_number(args.timeout), EXIT_TIMEOUT)
-                exit_code = EXIT_TIMEOUT
-                break
-
-            for child in services:
-                outcome = None
-                if child.state == Child.RUNNING:
-                    reset_if_healthy(child, now)
-                if child.state == Child.RUNNING and not child.alive():
-                    outcome = handle_exit(child, now)
-                elif child.state == Child.WAITING and now >= child.restart_at:
-                    child.restart_at = None
-                    if not child.start(env):
-                        outcome = handle_exit(child, now)
-                if outcome is not None:
-                    end_reason, exit_code = outcome
-                    break
-            if end_reason is not None:
-                break
-
-            resources.sample(services, now)
-
-            if logger is not None and not logger_warned and not logger.alive():
-                logger.finish_output()
-                say("WARNING: lcm-logger %s; the rest of this flight is NOT being recorded"
-                    % describe_exit(logger.proc.returncode)[1])
-                logger_warned = True
-
-            if all(c.state == Child.DONE for c in services):
-                end_reason = "no service left running; stopping"
-                failed = any((describe_exit(c.last_returncode)[0] or 0) != 0 or c.proc is None
-                             for c in services)
-                exit_code = 1 if failed else 0
-                break
-            time.sleep(POLL_INTERVAL_S)
-
-        say(end_reason)
+        watch_run(supervisor, deadline, resources, logger, say)
+        say(supervisor.end_reason)
     finally:
         # Services first (reverse start order, so consumers go before the
         # producers they depend on), the logger last so it captures their
@@ -1131,7 +1194,7 @@ def main(argv=None):
         if resources is not None:
             resources.close()
         print_summary(services, console, args.max_restarts, resources)
-    return exit_code
+    return supervisor.exit_code
 
 
 def print_summary(services, console, max_restarts, resources=None):
