@@ -16,6 +16,7 @@
 #include "ofn/common/validate/obstacle_grid.hpp"
 #include "ofn/common/validate/scan_world.hpp"
 #include "ofn/rh_optimizer/start_state.hpp"
+#include "ofn/rh_optimizer/step_problem.hpp"
 
 namespace ofn::rh {
 namespace {
@@ -25,9 +26,6 @@ Vec3 vec3_in(YamlReader& r, const std::string& key, const Vec3& fallback, double
       r.numbers_in(key, {fallback.x(), fallback.y(), fallback.z()}, lo, hi);
   return Vec3(v[0], v[1], v[2]);
 }
-
-// m beyond the planned clearance an escape leg's end is kept from the map.
-constexpr double kEscapeEndMargin = 0.3;
 
 int8_t stats_status(StepMode mode) {
   switch (mode) {
@@ -656,8 +654,6 @@ void RhOptimizerService::tick() {
         t, nominal.least_clearance, required, nominal.conflict_distance);
 
   StepInput in;
-  RhProblem& p = in.problem;
-  p.frame = GuidanceFrame::from_leg(leg.from, leg.to);
   // On the last plan while the vehicle is near it, else at the measured
   // state (start_state.hpp).
   StartStateSettings start_rules;
@@ -669,22 +665,14 @@ void RhOptimizerService::tick() {
       choose_start_state(last_trajectory_, to_seconds(now - last_trajectory_t0_),
                          MeasuredState{position, velocity, to_vec3(nav_->acceleration)},
                          mission_->limits.max_accel, start_rules);
-  p.position = start.position;
-  p.velocity = start.velocity;
-  p.acceleration = start.acceleration;
-  p.target = leg.to;
-  const double x_target = p.frame.to_guidance(leg.to).x();
-  const double min_horizon = std::min(limits.sensor_range, 4.0 * limits.clearance);
-  p.terminal_x =
-      terminal_x(p.frame, heightfield_, position, limits.sensor_range,
-                 limits.clearance + config_.optimizer.clearance_margin, x_target, min_horizon);
-  // With the last waypoint within the horizon, plan the stop there: a
-  // trajectory that only has to reach its x would arrive at cruise speed and
-  // leave waypoint guidance no room to brake.
-  p.stop_at_target = active->final && p.terminal_x >= x_target;
+  FramingSettings framing;
+  framing.clearance_margin = config_.optimizer.clearance_margin;
+  framing.pinch_clearance = pinch_clearance(limits);
+  framing.max_shift = config_.passages.max_shift;
+  in.problem =
+      leg_problem(leg, active->final, start, position, limits, clearance, heightfield_, framing);
+  RhProblem& p = in.problem;
   stopping_at_target_ = p.stop_at_target;
-  p.limits = limits;
-  p.clearance = clearance;
   in.time = t;
   if (!route_.empty() && now - route_utime_ <= to_utime(config_.path_max_age))
     in.global_path = route_;
@@ -715,29 +703,7 @@ void RhOptimizerService::tick() {
     // The leg of the escape: from where it began to where the route turns
     // forward again, along the route; the forward-speed rule of Eq. 8 is
     // relaxed (the route may bend back), the commit gate is not.
-    const double planned_clearance = limits.clearance + config_.optimizer.clearance_margin;
-    // The end is looked for as the route check looked for room at the
-    // corner (room_to_stop): kept kEscapeEndMargin beyond the clearance
-    // where that fits, else at the clearance, else at what the check asked
-    // (the clearance less the solver's tolerance), which the check found.
-    // Searched another way (a gradient, then rings), a corner the check
-    // passed could be one where the escape found no end, and stalled.
-    Vec3 leg_end = recovery.escape_point;
-    for (const double wanted :
-         {planned_clearance + kEscapeEndMargin, planned_clearance, pinch_clearance(limits)})
-      if (const auto room =
-              room_to_stop(clearance, recovery.escape_point, wanted, config_.passages.max_shift)) {
-        leg_end = *room;
-        break;
-      }
-    p.frame = GuidanceFrame::from_leg(recovery.escape_from, leg_end);
-    p.target = leg_end;
-    const double x_escape = p.frame.to_guidance(leg_end).x();
-    p.terminal_x =
-        terminal_x(p.frame, heightfield_, position, limits.sensor_range,
-                   limits.clearance + config_.optimizer.clearance_margin, x_escape, min_horizon);
-    p.stop_at_target = p.terminal_x >= x_escape;
-    p.limits.min_forward_speed = -limits.max_speed;
+    frame_escape(&p, recovery.escape_from, recovery.escape_point, position, heightfield_, framing);
     stopping_at_target_ = false;
     in.global_path = recovery.escape_route;
   }
@@ -754,10 +720,7 @@ void RhOptimizerService::tick() {
   ++steps_;
   // A plan that moves off, not a stop, a stall or a hover in place: the
   // recovery counts the vehicle stuck without one.
-  last_step_moving_ =
-      out.mode == StepMode::kSolved && !out.stalled &&
-      (out.trajectory.position(out.trajectory.duration()) - out.trajectory.position(0.0)).norm() >
-          2.0 * config_.recovery.capture_radius;
+  last_step_moving_ = plan_moves_off(out, 2.0 * config_.recovery.capture_radius);
   // Deferring leaves the vehicle to nominal guidance: only before this
   // engagement has published anything. Once a plan or a stop has been
   // flown, the controller holds to it (and to its stop) and a silence
