@@ -30,8 +30,8 @@ struct Box {
   float top;  // m above ground
 };
 
-/// The clearance over north [-20, 180), east [-60, 60) with these boxes.
-inline ClearanceQuery field_with(const std::vector<Box>& boxes) {
+/// The map of north [-20, 180), east [-60, 60) with these boxes, 1 m cells.
+inline mapping::Heightfield heightfield_with(const std::vector<Box>& boxes) {
   mapping::Heightfield heightfield;
   heightfield.origin_north = -20;
   heightfield.origin_east = -60;
@@ -44,8 +44,13 @@ inline ClearanceQuery field_with(const std::vector<Box>& boxes) {
         const int r = heightfield.row_of(n + 0.5), c = heightfield.col_of(e + 0.5);
         if (heightfield.inside(r, c)) heightfield.at(r, c) = b.top;
       }
+  return heightfield;
+}
+
+/// The clearance over north [-20, 180), east [-60, 60) with these boxes.
+inline ClearanceQuery field_with(const std::vector<Box>& boxes) {
   auto field = std::make_shared<mapping::DistanceField>();
-  field->build(heightfield, 0.0, 80.0);
+  field->build(heightfield_with(boxes), 0.0, 80.0);
   return [field](const Vec3& ned) { return field->query(ned); };
 }
 

@@ -16,16 +16,9 @@ using testing_support::kLegAltitude;
 
 const Leg kLeg{Vec3(0, 0, -kLegAltitude), Vec3(300, 0, -kLegAltitude)};
 
-// Nothing mapped over north [0, 400), east [-50, 50).
+// Nothing mapped over north [-20, 180), east [-60, 60).
 mapping::Heightfield open_grid() {
-  mapping::Heightfield g;
-  g.origin_north = 0;
-  g.origin_east = -50;
-  g.resolution = 1;
-  g.rows = 400;
-  g.cols = 100;
-  g.top.assign(static_cast<size_t>(g.rows) * g.cols, 0.0f);
-  return g;
+  return testing_support::heightfield_with({});
 }
 
 StartState start_at(const Vec3& position) {
