@@ -12,17 +12,14 @@ Utime WallClock::now() const {
       .count();
 }
 
-ScaledWallClock::ScaledWallClock(Utime start, double real_time_factor, double stall,
+ScaledWallClock::ScaledWallClock(Utime start, double real_time_factor, double max_advance,
                                  WallSource wall)
-    : start_(start),
-      factor_(real_time_factor),
-      stall_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-          std::chrono::duration<double>(stall))),
-      wall_(wall),
-      wall_start_(wall()),
-      last_read_(wall_start_) {
+    : start_(start), factor_(real_time_factor), wall_(wall), wall_start_(wall()) {
   if (!(real_time_factor > 0.0)) throw std::invalid_argument("real-time factor must be > 0");
-  if (!(stall > 0.0)) throw std::invalid_argument("stall time must be > 0");
+  if (!(max_advance > 0.0)) throw std::invalid_argument("max_advance must be > 0");
+  stall_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(max_advance / real_time_factor));
+  last_read_ = wall_start_;
 }
 
 Utime ScaledWallClock::now() const {

@@ -41,6 +41,11 @@ int main(int argc, char** argv) {
         ofn::vehicle::write_checkpoint_file(checkpoint_path, c);
       });
     service.node().log().info("scenario '{}', clock {}", scenario.name, clock.describe());
-    return ofn::run_nodes(*lcm, clock, {&service.node()});
+    const int code = ofn::run_nodes(*lcm, clock, {&service.node()});
+    // Wall time the simulated world waited for its simulator: how far the
+    // run fell short of its real-time factor.
+    service.node().log().info("the clock waited {:.2f} s of wall time for the simulator",
+                              clock.paused());
+    return code;
   });
 }

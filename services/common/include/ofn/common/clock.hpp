@@ -23,15 +23,20 @@ class WallClock final : public Clock {
 
 /// Simulation master clock: starts at `start` and advances at
 /// `real_time_factor` times the wall (steady) clock. The simulated world
-/// waits while its simulator does not run: wall time between two reads
-/// beyond `stall` (a stopped or starved process; the simulator reads it at
-/// its physics rate) does not advance the clock past `stall`. Jumping it
-/// instead integrated seconds of the airframe at once on the last command
-/// while every other service's SIM_CLOCK stood still.
+/// waits while its simulator does not run: between two reads (the
+/// simulator reads it at its physics rate) the clock advances by at most
+/// `max_advance` seconds of its own time, whatever the wall did (a stopped
+/// or starved process, a host that lost the CPU). Jumping it instead
+/// integrated the airframe open loop on the last command through the gap
+/// while every other service's SIM_CLOCK stood still: a 0.43 s stall of
+/// the whole host at 2x real time flew 0.87 s without control, and the
+/// controller found its reference lapsed. The default, 0.05 s, is five
+/// periods of the 100 Hz control loop.
 class ScaledWallClock final : public Clock {
  public:
   using WallSource = std::chrono::steady_clock::time_point (*)();
-  ScaledWallClock(Utime start, double real_time_factor, double stall = 0.5,
+  static constexpr double kDefaultMaxAdvance = 0.05;  // s of simulated time
+  ScaledWallClock(Utime start, double real_time_factor, double max_advance = kDefaultMaxAdvance,
                   WallSource wall = &std::chrono::steady_clock::now);
   Utime now() const override;
   double wall_seconds_per_clock_second() const override { return 1.0 / factor_; }
@@ -42,7 +47,7 @@ class ScaledWallClock final : public Clock {
  private:
   Utime start_;
   double factor_;
-  std::chrono::steady_clock::duration stall_;
+  std::chrono::steady_clock::duration stall_;  // wall time of max_advance
   WallSource wall_;
   std::chrono::steady_clock::time_point wall_start_;
   mutable std::mutex mutex_;
