@@ -32,6 +32,12 @@ ReferenceChoice choose_reference(const StepSituation& s) {
     // new mission (the vehicle may have been flown meanwhile) and after a
     // lapse.
     c.hold_begins = previous != ControlMode::kHold || s.mission_arrived || s.lapsed;
+    // The control law begins again with it: what its integrators, networks
+    // and actuator estimate hold was learnt against a reference the vehicle
+    // was not flying (a simulated vehicle is frozen until the mission
+    // comes; a real one is flown by its pilot). Carried over, the wound-up
+    // command of the wait was flown on release and the vehicle surged.
+    c.reset_control = c.hold_begins;
     return c;
   }
   c.reset_control = previous == ControlMode::kHold;

@@ -18,14 +18,20 @@ StepSituation guided_flight() {
 
 TEST(ReferenceSource, NoMissionHolds) {
   StepSituation s;  // navigation just arrived, nothing else
-  const ReferenceChoice c = choose_reference(s);
+  ReferenceChoice c = choose_reference(s);
   EXPECT_EQ(c.source, ReferenceSource::kHold);
   EXPECT_EQ(c.mode, ControlMode::kHold);
   EXPECT_TRUE(c.hold_begins);  // entered from NAV_STALE
+  EXPECT_TRUE(c.reset_control);
   s.previous = ControlMode::kHold;
-  EXPECT_FALSE(choose_reference(s).hold_begins);  // the same hold goes on
+  c = choose_reference(s);
+  EXPECT_FALSE(c.hold_begins);  // the same hold goes on
+  EXPECT_FALSE(c.reset_control);
   s.lapsed = true;
-  EXPECT_TRUE(choose_reference(s).hold_begins);  // begun again from the vehicle
+  c = choose_reference(s);
+  EXPECT_TRUE(c.hold_begins);  // begun again from the vehicle
+  EXPECT_TRUE(c.reset_control);
+  s.lapsed = false;
   // A plan without a mission is not flown.
   s.fresh_plan = true;
   EXPECT_EQ(choose_reference(s).source, ReferenceSource::kHold);
@@ -41,8 +47,13 @@ TEST(ReferenceSource, AMissionHoldsUntilThePlannerConfirms) {
   ReferenceChoice c = choose_reference(s);
   EXPECT_EQ(c.source, ReferenceSource::kHold);
   EXPECT_TRUE(c.hold_begins);  // the mission's hold starts where the vehicle is
+  // and so does the control law: what it learnt while the vehicle was held
+  // (or flown by its pilot) is not flown on release.
+  EXPECT_TRUE(c.reset_control);
   s.mission_arrived = false;
-  EXPECT_FALSE(choose_reference(s).hold_begins);
+  c = choose_reference(s);
+  EXPECT_FALSE(c.hold_begins);
+  EXPECT_FALSE(c.reset_control);
   // A plan arrives before the first confirmation: it is flown, and the
   // control law leaves the hold afresh.
   s.fresh_plan = true;

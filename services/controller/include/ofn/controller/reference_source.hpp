@@ -71,7 +71,7 @@ struct ReferenceChoice {
   bool stop_from_vehicle = false;  // kBlindStop: from the vehicle, not the reference flown
   bool end_stop = false;           // kGuidance: the stop flown until now has ended
   bool resync_guidance = false;    // kGuidance: guidance restarts from the vehicle
-  bool reset_control = false;      // leaving the hold: the control law begins again
+  bool reset_control = false;      // a hold begins or is left: the control law begins again
 };
 
 ReferenceChoice choose_reference(const StepSituation& s);
