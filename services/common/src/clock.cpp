@@ -14,12 +14,16 @@ Utime WallClock::now() const {
 
 ScaledWallClock::ScaledWallClock(Utime start, double real_time_factor, double max_advance,
                                  WallSource wall)
-    : start_(start), factor_(real_time_factor), wall_(wall), wall_start_(wall()) {
+    : start_(start),
+      factor_(real_time_factor),
+      wall_(wall),
+      wall_start_(wall()),
+      last_read_(wall_start_) {
   if (!(real_time_factor > 0.0)) throw std::invalid_argument("real-time factor must be > 0");
   if (!(max_advance > 0.0)) throw std::invalid_argument("max_advance must be > 0");
+  // After the checks: the allowance in wall time divides by the factor.
   stall_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(max_advance / real_time_factor));
-  last_read_ = wall_start_;
 }
 
 Utime ScaledWallClock::now() const {
