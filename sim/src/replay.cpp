@@ -225,6 +225,9 @@ MessageDifference difference(const solver_stats_t& a, const solver_stats_t& b) {
   d.number(a.max_constraint_violation, b.max_constraint_violation);
   d.number(a.cost, b.cost);
   d.same(a.warm_started, b.warm_started);
+  d.same(a.guidance_clear, b.guidance_clear);
+  d.same(a.mission_id, b.mission_id);
+  d.same(a.active_waypoint, b.active_waypoint);
   return d.largest();
 }
 

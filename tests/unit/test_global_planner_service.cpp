@@ -15,6 +15,7 @@
 #include "ofn/common/logging.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/validate/global_path.hpp"
+#include "ofn/control_status_t.hpp"
 #include "ofn/global_planner/global_planner_service.hpp"
 #include "service_test_bus.hpp"
 
@@ -212,6 +213,46 @@ TEST_F(GlobalPlannerServiceTest, ThePassagesOfThisMissionAreRoutedRound) {
        passages(kStart, plan.mission_id, std::numeric_limits<double>::quiet_NaN()));
   EXPECT_EQ(service_.node().counters().rejected, rejected + 1);
   EXPECT_EQ(paths_.size(), 2u);
+}
+
+TEST_F(GlobalPlannerServiceTest, AnOutAndBackRouteFollowsTheControllersLeg) {
+  // Out to 152.4 m and back to the start over the same line: from the
+  // vehicle's position the two legs cannot be told apart.
+  mission_t out_and_back = mission();
+  out_and_back.waypoints.push_back(out_and_back.waypoints.front());
+  out_and_back.num_waypoints = 3;
+  send(channels::kMission, out_and_back);
+  send(channels::kNavState, nav(kStart, 60.0));
+  cuboid_list_t no_cuboids{};
+  no_cuboids.utime = kStart;
+  no_cuboids.frame = "NED";
+  send(channels::kCuboids, no_cuboids);
+  ASSERT_FALSE(paths_.empty());
+  EXPECT_NEAR(paths_.back().points.back()[0], 152.4, 1e-9);  // outwards first
+
+  // The controller's word for another mission is no word.
+  control_status_t status{};
+  status.utime = bus_.now();
+  status.mission_id = out_and_back.mission_id + 1;
+  status.active_waypoint = 2;
+  send(channels::kControlStatus, status);
+  send(channels::kNavState, nav(bus_.now(), 60.0));
+  EXPECT_NEAR(paths_.back().points.back()[0], 152.4, 1e-9);
+
+  // This mission's: the way back.
+  status.mission_id = out_and_back.mission_id;
+  send(channels::kControlStatus, status);
+  const size_t before = paths_.size();
+  send(channels::kNavState, nav(bus_.now(), 60.0));
+  ASSERT_GT(paths_.size(), before);
+  EXPECT_NEAR(paths_.back().points.back()[0], -30.48, 1e-9);
+
+  // And never back out again.
+  status.active_waypoint = 1;
+  send(channels::kControlStatus, status);
+  send(channels::kNavState, nav(bus_.now(), 60.0));
+  advance_to(bus_.now() + 2 * kMicrosPerSecond);
+  EXPECT_NEAR(paths_.back().points.back()[0], -30.48, 1e-9);
 }
 
 }  // namespace

@@ -67,6 +67,10 @@ class PlannerStandIn {
       : node_("planner_stand_in", lockstep.lcm(), lockstep.clock()), silent_after_(silent_after) {
     node_.add_timer(
         0.1, [this] { publish(); }, "status");
+    // It clears the leg the controller flies, as the optimiser does.
+    node_.subscribe<control_status_t>(channels::kControlStatus, [this](const control_status_t& m) {
+      leg_ = {m.mission_id, m.active_waypoint};
+    });
   }
   Node& node() { return node_; }
   double speaks_from = 0;
@@ -81,10 +85,13 @@ class PlannerStandIn {
     s.message = "nominal guidance: path clear";
     s.map_utime = now;
     s.guidance_clear = true;
+    s.mission_id = leg_.first;
+    s.active_waypoint = leg_.second;
     node_.publish(channels::kSolverStats, s);
   }
   Node node_;
   double silent_after_;
+  std::pair<int, int> leg_{-1, -1};  // mission id, waypoint
 };
 
 FlightResult fly_open_course(const Scenario& scenario, bool scanner = true,

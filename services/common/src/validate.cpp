@@ -252,6 +252,7 @@ std::string validate(const ref_traj_t& m) {
 std::string validate(const solver_stats_t& m) {
   const double v[3] = {m.solve_time, m.max_constraint_violation, m.cost};
   if (!all_finite(v)) return "statistics not finite";
+  if (m.active_waypoint < -1) return "active waypoint below -1";
   return "";
 }
 
@@ -260,6 +261,7 @@ std::string validate(const control_status_t& m) {
       !all_finite(m.ref_acceleration) || !all_finite(m.commanded_acceleration) ||
       !all_finite(m.position_error) || !all_finite(m.adaptive_output))
     return "status not finite";
+  if (m.active_waypoint < -1) return "active waypoint below -1";
   return "";
 }
 

@@ -284,8 +284,10 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
 }
 
 void ControllerService::on_solver_stats(const solver_stats_t& m) {
+  const MissionLeg checked{m.mission_id, m.active_waypoint};
   perception_.on_status(to_seconds(m.utime), m.map_utime > 0 ? to_seconds(m.map_utime) : 0.0,
-                        m.guidance_clear);
+                        m.guidance_clear, checked);
+  planner_leg_ = checked;
 }
 
 void ControllerService::on_mission(const mission_t& m) {
@@ -466,6 +468,13 @@ void ControllerService::control_step() {
                           limits_from(mission_->limits), x.position, x.velocity);
     mission_pending_ = false;
   }
+  // Guidance flies the planner's leg (WaypointGuidance::follow_leg).
+  if (mission_ && planner_leg_.mission_id == mission_->mission_id &&
+      guidance_.follow_leg(planner_leg_.waypoint, mode_ == control_status_t::WAYPOINT, x.position,
+                           x.velocity))
+    node_.log().info("on to the planner's leg: waypoint {} at t={:.2f} s", planner_leg_.waypoint,
+                     to_seconds(now));
+  const MissionLeg flown{mission_ ? mission_->mission_id : -1, guidance_.active_waypoint()};
   // The governor acts at the limits themselves: the vehicle still overshoots
   // what the governor allows by up to 0.15 ft/s at 10 ft/s when a curve and
   // the yaw sweep meet (the tilt lags the heading), and that must fit in the
@@ -481,7 +490,7 @@ void ControllerService::control_step() {
   // Whether the planner's word or its map is stale, and why (for the log);
   // at the last waypoint it no longer matters.
   const auto blind =
-      previous == control_status_t::DONE ? std::nullopt : perception_.stale(to_seconds(now));
+      previous == control_status_t::DONE ? std::nullopt : perception_.stale(to_seconds(now), flown);
   StepSituation situation;
   situation.previous = static_cast<ControlMode>(previous);
   situation.has_mission = guidance_.has_mission();
@@ -551,7 +560,6 @@ void ControllerService::control_step() {
       }
       if (choice.resync_guidance) guidance_.resync(x.position, x.velocity);
       const GuidanceReference g = guidance_.update(x.position, x.velocity, dt);
-      active_waypoint_ = g.active_waypoint;
       ref.position = g.position;
       ref.velocity = g.velocity;
       ref.acceleration = g.acceleration;
@@ -595,7 +603,7 @@ void ControllerService::publish_status() {
   s.utime = node_.now();
   s.mode = mode_;
   s.mission_id = mission_ ? mission_->mission_id : -1;
-  s.active_waypoint = active_waypoint_;
+  s.active_waypoint = guidance_.active_waypoint();
   put(s.ref_position, last_ref_.position);
   put(s.ref_velocity, last_ref_.velocity);
   put(s.ref_acceleration, last_ref_.acceleration);

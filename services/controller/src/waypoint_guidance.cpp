@@ -16,6 +16,7 @@ void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, doubl
                       : cruise_speed;
   limits_ = limits;
   done_ = false;
+  leg_cap_ = std::numeric_limits<int>::max();
   if (waypoints_.empty()) return;
   const int best = nearest_leg(waypoints_, position);
   // Start the leg at the vehicle's projection onto it, so the reference
@@ -34,6 +35,31 @@ void WaypointGuidance::start_leg(const Vec3& from, int to_index, double speed_al
   s_ = 0;
   s_dot_ = std::max(0.0, speed_along);
   s_ddot_ = 0;
+}
+
+void WaypointGuidance::next_leg_from_reference() {
+  const Vec3 ref_point = leg_start_ + leg_dir_ * s_;
+  const Vec3 next = waypoints_[active_ + 1].position - ref_point;
+  // Keep the part of the speed that lies along the new leg.
+  const double carried =
+      next.norm() > 1e-9 ? s_dot_ * std::max(0.0, leg_dir_.dot(next.normalized())) : 0.0;
+  start_leg(ref_point, active_ + 1, carried);
+}
+
+bool WaypointGuidance::follow_leg(int index, bool flying, const Vec3& position,
+                                  const Vec3& velocity) {
+  if (waypoints_.empty() || active_ < 0 || index < 0 ||
+      index >= static_cast<int>(waypoints_.size()))
+    return false;
+  leg_cap_ = index;
+  if (index <= active_) return false;
+  if (flying && index == active_ + 1) {
+    next_leg_from_reference();
+  } else {
+    start_leg(waypoints_[index - 1].position, index, 0.0);
+    resync(position, velocity);
+  }
+  return true;
 }
 
 void WaypointGuidance::resync(const Vec3& position, const Vec3& velocity) {
@@ -60,17 +86,13 @@ GuidanceReference WaypointGuidance::update(const Vec3& position, const Vec3& vel
   const double accel = config_.accel_fraction * limits_.max_accel;
 
   // Leg switching: inside the capture radius of an intermediate waypoint,
-  // or with the reference at its end, fly on from where the reference is.
-  while (!final_leg()) {
+  // or with the reference at its end, fly on from where the reference is;
+  // not past the planner's leg.
+  while (!final_leg() && active_ < leg_cap_) {
     const Vec3& target = waypoints_[active_].position;
     if ((position - target).norm() > waypoints_[active_].capture_radius && s_ < leg_length_ - 1e-9)
       break;
-    const Vec3 ref_point = leg_start_ + leg_dir_ * s_;
-    const Vec3 next = waypoints_[active_ + 1].position - ref_point;
-    // Keep the part of the speed that lies along the new leg.
-    const double carried =
-        next.norm() > 1e-9 ? s_dot_ * std::max(0.0, leg_dir_.dot(next.normalized())) : 0.0;
-    start_leg(ref_point, active_ + 1, carried);
+    next_leg_from_reference();
   }
 
   const double remaining = leg_length_ - s_;

@@ -51,6 +51,62 @@ struct PerfectFollower {
   }
 };
 
+TEST(WaypointGuidance, AnOutAndBackRouteIsFlownOutFirstAndThenBack) {
+  // The two legs lie on one line: from the start the outward leg is flown,
+  // then the way back, and the flight ends where it began.
+  const std::vector<Waypoint> wps = {
+      {Vec3(0, 0, -30), 5.0}, {Vec3(100, 0, -30), 5.0}, {Vec3(0, 0, -30), 5.0}};
+  PerfectFollower f(wps, 10.0, limits(10, 2, 3), Vec3(1e-3, 2e-4, -30));
+  ASSERT_TRUE(f.run(60));
+  EXPECT_EQ(f.refs.front().active_waypoint, 1);
+  double furthest = 0;
+  for (const Vec3& p : f.positions) furthest = std::max(furthest, p.x());
+  EXPECT_GT(furthest, 95.0);
+  EXPECT_EQ(f.refs.back().active_waypoint, 2);
+  EXPECT_LT((f.positions.back() - wps.back().position).norm(), 5.0);
+}
+
+TEST(WaypointGuidance, FliesThePlannersLegAndMovesOnWithIt) {
+  const std::vector<Waypoint> wps = {
+      {Vec3(0, 0, -30), 5.0}, {Vec3(100, 0, -30), 5.0}, {Vec3(0, 0, -30), 5.0}};
+  PerfectFollower f(wps, 10.0, limits(10, 2, 3), Vec3(1e-3, 0, -30));
+  EXPECT_FALSE(f.guidance.follow_leg(-1, true, f.position, f.velocity));  // the planner has none
+  EXPECT_FALSE(f.guidance.follow_leg(3, true, f.position, f.velocity));   // no such waypoint
+  EXPECT_FALSE(f.guidance.follow_leg(1, true, f.position, f.velocity));   // the same leg: a cap
+  // Inside waypoint 1's capture radius guidance waits for the planner.
+  while (f.position.x() < 97.0 && f.refs.size() < 3000) ASSERT_FALSE(f.run(kDt));
+  ASSERT_GE(f.position.x(), 97.0);
+  ASSERT_FALSE(f.run(0.1));
+  EXPECT_EQ(f.refs.back().active_waypoint, 1);
+  const Vec3 before = f.refs.back().position;
+  // The planner moves on: on from where the reference is, no jump.
+  EXPECT_TRUE(f.guidance.follow_leg(2, true, f.position, f.velocity));
+  EXPECT_EQ(f.guidance.active_waypoint(), 2);
+  const GuidanceReference next = f.guidance.update(f.position, f.velocity, kDt);
+  EXPECT_EQ(next.active_waypoint, 2);
+  EXPECT_LT((next.position - before).norm(), 0.2);
+  EXPECT_FALSE(f.guidance.follow_leg(1, true, f.position, f.velocity));  // never back
+  EXPECT_EQ(f.guidance.active_waypoint(), 2);
+}
+
+TEST(WaypointGuidance, APlannerFurtherOnWhilePlansAreFlownGivesTheTrueLeg) {
+  // The planner flew the vehicle out and most of the way back; guidance,
+  // idle meanwhile, takes up the way back from waypoint 1, with the
+  // reference on the vehicle's projection.
+  const std::vector<Waypoint> wps = {
+      {Vec3(0, 0, -30), 5.0}, {Vec3(100, 0, -30), 5.0}, {Vec3(0, 0, -30), 5.0}};
+  WaypointGuidance g;
+  g.set_mission(wps, 10.0, limits(10, 2, 3), Vec3(0, 0, -30), Vec3::Zero());
+  g.update(Vec3(0, 0, -30), Vec3::Zero(), kDt);
+  const Vec3 vehicle(30, 2, -30);
+  ASSERT_TRUE(g.follow_leg(2, false, vehicle, Vec3(-3, 0, 0)));
+  const GuidanceReference r = g.update(vehicle, Vec3(-3, 0, 0), kDt);
+  EXPECT_EQ(r.active_waypoint, 2);
+  EXPECT_TRUE(r.position.isApprox(Vec3(30, 0, -30), 1e-9));
+  EXPECT_TRUE(r.leg_direction.isApprox(Vec3(-1, 0, 0), 1e-9));
+  EXPECT_NEAR(r.velocity.x(), -3.0, 1e-9);
+}
+
 TEST(WaypointGuidance, WithoutMissionGivesNoWaypoint) {
   WaypointGuidance g;
   EXPECT_FALSE(g.has_mission());

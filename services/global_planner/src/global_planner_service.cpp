@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/validate/control_status.hpp"
 #include "ofn/common/validate/cuboid_list.hpp"
 #include "ofn/common/validate/mission.hpp"
 #include "ofn/common/validate/narrow_passages.hpp"
@@ -129,6 +130,12 @@ GlobalPlannerService::GlobalPlannerService(lcm::LCM& lcm, const Clock& clock,
   node_.subscribe<cuboid_list_t>(
       channels::kCuboids, [this](const cuboid_list_t& m) { on_cuboids(m); },
       SubscribeOptions{config_.cuboids_max_age, 0.5});
+  // The controller's leg moves this one on (LegTracker::follow); on_nav
+  // replans for the new target.
+  node_.subscribe<control_status_t>(
+      channels::kControlStatus,
+      [this](const control_status_t& m) { legs_.follow(m.mission_id, m.active_waypoint); },
+      SubscribeOptions{config_.nav_max_age, 0.5});
   // The whole list of the mission each time, whatever its age: a passage
   // found narrow stays narrow.
   node_.subscribe<narrow_passages_t>(
@@ -204,7 +211,7 @@ void GlobalPlannerService::replan(const char* why) {
     return;
   }
   const Vec3 position = to_vec3(nav_->position);
-  if (!legs_.has_plan()) legs_.set_plan(waypoints_from(*mission_), position);
+  if (!legs_.has_plan()) legs_.set_plan(mission_->mission_id, waypoints_from(*mission_), position);
   const auto leg = legs_.update(position);
   if (!leg) return;
   active_leg_ = leg->index;

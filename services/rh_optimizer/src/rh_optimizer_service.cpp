@@ -10,6 +10,7 @@
 #include "ofn/common/channels.hpp"
 #include "ofn/common/message_checks.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
+#include "ofn/common/validate/control_status.hpp"
 #include "ofn/common/validate/global_path.hpp"
 #include "ofn/common/validate/mission.hpp"
 #include "ofn/common/validate/nav_state.hpp"
@@ -286,6 +287,11 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
   node_.subscribe<global_path_t>(
       channels::kGlobalPath, [this](const global_path_t& m) { on_global_path(m); },
       SubscribeOptions{config_.path_max_age, 0.5});
+  // The controller's leg moves this one on (LegTracker::follow).
+  node_.subscribe<control_status_t>(
+      channels::kControlStatus,
+      [this](const control_status_t& m) { legs_.follow(m.mission_id, m.active_waypoint); },
+      SubscribeOptions{config_.nav_max_age, 0.5});
   if (config_.occlusion_depth > 0)
     node_.subscribe<scan_world_t>(
         channels::kScanWorld, [this](const scan_world_t& m) { on_scan(m); },
@@ -558,6 +564,8 @@ void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::stri
   step_warned_ = false;
   solver_stats_t s{};
   s.guidance_clear = guidance_clear && field_valid_;
+  s.mission_id = mission_ ? mission_->mission_id : -1;
+  s.active_waypoint = active_leg_;
   s.utime = now;
   s.status = status;
   s.message = recovery_message(recovery_.phase(), message);
@@ -585,7 +593,7 @@ void RhOptimizerService::tick() {
   }
   const Vec3 position = to_vec3(nav_->position);
   const Vec3 velocity = to_vec3(nav_->velocity);
-  if (!legs_.has_plan()) legs_.set_plan(waypoints_from(*mission_), position);
+  if (!legs_.has_plan()) legs_.set_plan(mission_->mission_id, waypoints_from(*mission_), position);
   const auto active = legs_.update(position);
   if (!active) return note("no leg");
   if (active->index != active_leg_) {

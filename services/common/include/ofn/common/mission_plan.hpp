@@ -4,7 +4,11 @@
 // guidance owns the reference it flies; the planners only need to know the
 // leg (previous waypoint -> target) to set up the guidance frame, by the
 // same rule: start on the leg nearest the vehicle, move on inside a
-// waypoint's capture radius or once past the waypoint along the leg.
+// waypoint's capture radius or once past the waypoint along the leg. The
+// controller's word (CONTROL_STATUS.active_waypoint) moves a planner on
+// too: where legs lie over each other (a route flown out and back) the
+// vehicle's position alone cannot tell them apart, and a planner picked
+// up mid-route would otherwise watch a leg the controller is not flying.
 
 #include <algorithm>
 #include <limits>
@@ -43,8 +47,10 @@ struct ActiveLeg {
 
 class LegTracker {
  public:
-  /// Starts a plan at the leg nearest `position` (ties go to the later leg).
-  void set_plan(std::vector<Waypoint> waypoints, const Vec3& position) {
+  /// Starts plan `plan_id` at the leg nearest `position` (ties go to the
+  /// earliest leg; update() then moves on past a waypoint already reached).
+  void set_plan(int plan_id, std::vector<Waypoint> waypoints, const Vec3& position) {
+    plan_id_ = plan_id;
     waypoints_ = std::move(waypoints);
     active_ = nearest_leg(waypoints_, position);
     single_from_ = position;  // where a single-waypoint plan's leg starts
@@ -55,6 +61,18 @@ class LegTracker {
     active_ = -1;
   }
   bool has_plan() const { return active_ >= 0; }
+
+  /// The controller flies to waypoint `index` of plan `plan_id`: a leg
+  /// further on is taken up, never one behind (the planners may move on
+  /// first: the controller's guidance does not advance while it flies
+  /// their plan). Another plan's word, or an index outside this plan, is
+  /// ignored. Returns whether the leg changed.
+  bool follow(int plan_id, int index) {
+    if (!has_plan() || plan_id != plan_id_) return false;
+    if (index <= active_ || index >= static_cast<int>(waypoints_.size())) return false;
+    active_ = index;
+    return true;
+  }
 
   /// Moves on past every waypoint captured or passed; the leg now flown.
   std::optional<ActiveLeg> update(const Vec3& position) {
@@ -79,6 +97,7 @@ class LegTracker {
     return length > 1e-9 && (position - from).dot(leg / length) >= length;
   }
 
+  int plan_id_ = -1;
   std::vector<Waypoint> waypoints_;
   int active_ = -1;
   Vec3 single_from_ = Vec3::Zero();

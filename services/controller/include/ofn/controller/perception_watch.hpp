@@ -12,7 +12,8 @@
 // the multi-fragment SCAN_WORLD messages), or no status yet: guidance
 // stops (the controller flies the stop of braking.hpp and hovers) until
 // fresh confirmation returns. Plans already committed by the optimiser are
-// not affected: each carries its own stop in space seen free.
+// not affected: each carries its own stop in space seen free. A clear
+// word holds for the leg it was given on (mission and waypoint) only.
 // Pure core; times in seconds of the caller's clock.
 
 #include <cmath>
@@ -32,19 +33,31 @@ struct PerceptionWatchSettings {
   bool enabled = true;
 };
 
+/// A leg of a mission: the mission's id and the index of the waypoint that
+/// ends the leg (-1: none).
+struct MissionLeg {
+  int mission_id = -1;
+  int waypoint = -1;
+  bool operator==(const MissionLeg& o) const {
+    return mission_id == o.mission_id && waypoint == o.waypoint;
+  }
+  bool operator!=(const MissionLeg& o) const { return !(*this == o); }
+};
+
 class PerceptionWatch {
  public:
   explicit PerceptionWatch(PerceptionWatchSettings settings = {}) : settings_(settings) {}
 
   /// A planner status stamped `stamp`, checked on a map stamped `map_stamp`
-  /// (<= 0: no map yet), saying whether the nominal leg is clear for
+  /// (<= 0: no map yet), saying whether its leg `checked` is clear for
   /// guidance (false while the planner is avoiding, looking around or has no
   /// route: guidance would fly the blocked leg). Older statuses than the
   /// last are ignored.
-  void on_status(double stamp, double map_stamp, bool guidance_clear);
+  void on_status(double stamp, double map_stamp, bool guidance_clear, MissionLeg checked);
 
-  /// Why guidance may not fly on at `now`, or nullopt when it may.
-  std::optional<std::string> stale(double now) const;
+  /// Why guidance may not fly leg `flown` on at `now`, or nullopt when it
+  /// may.
+  std::optional<std::string> stale(double now, MissionLeg flown) const;
 
   /// Whether a status on a map has ever come: before it, the flight has
   /// not begun (the controller goes on holding rather than stopping).
@@ -58,6 +71,7 @@ class PerceptionWatch {
   double map_stamp_ = -std::numeric_limits<double>::infinity();
   bool confirmed_once_ = false;
   bool guidance_clear_ = false;
+  MissionLeg checked_;
 };
 
 }  // namespace ofn::control

@@ -3,8 +3,13 @@
 // legs between waypoints flown at cruise speed, speeding up and slowing down
 // within a fraction of the acceleration limit, switching to the next leg
 // inside the waypoint's capture radius and stopping at the last waypoint.
+// With a planner, the leg flown is the planner's (follow_leg): guidance
+// flies only what the planner has checked, and where legs lie over each
+// other (a route flown out and back) the vehicle's position alone cannot
+// say which is meant.
 // Pure core: positions in world NED, SI units.
 
+#include <limits>
 #include <vector>
 
 #include "ofn/common/frames.hpp"
@@ -40,10 +45,24 @@ class WaypointGuidance {
                    const Limits& limits, const Vec3& position, const Vec3& velocity);
   void clear() { waypoints_.clear(); }
   bool has_mission() const { return !waypoints_.empty(); }
+  /// Index of the waypoint flown to; -1 without a mission.
+  int active_waypoint() const { return waypoints_.empty() ? -1 : active_; }
 
   /// Puts the reference back at the vehicle's projection on the active leg,
   /// after another source of reference (avoidance) has been flown.
   void resync(const Vec3& position, const Vec3& velocity);
+
+  /// The planner checks and plans along the leg to waypoint `index`:
+  /// guidance moves on to it when it is further on, and from now on does
+  /// not move past it by its own capture rule (it waits at most the
+  /// planner's next step there). `flying`: guidance is the reference flown
+  /// now; a move to the next leg then starts where the reference is, as its
+  /// own switch does. Otherwise (a plan is flown, or the move skips a
+  /// leg) the new leg is the plan's own, from the previous waypoint, and
+  /// the reference goes to the vehicle's projection on it. An index of -1
+  /// (the planner has no leg) or outside the plan changes nothing.
+  /// Returns whether the leg changed.
+  bool follow_leg(int index, bool flying, const Vec3& position, const Vec3& velocity);
 
   /// Advances the reference by dt and returns it. The first update after
   /// set_mission or resync is taken to be at the instant they were given the
@@ -53,6 +72,9 @@ class WaypointGuidance {
 
  private:
   void start_leg(const Vec3& from, int to_index, double speed_along);
+  /// On to the next leg from where the reference is, keeping the part of
+  /// its speed that lies along the new leg.
+  void next_leg_from_reference();
   double leg_speed_limit() const;
   bool final_leg() const { return active_ + 1 == static_cast<int>(waypoints_.size()); }
 
@@ -61,6 +83,7 @@ class WaypointGuidance {
   double cruise_speed_ = 0;
   Limits limits_;
   int active_ = -1;
+  int leg_cap_ = std::numeric_limits<int>::max();  // the planner's leg; no cap without one
   Vec3 leg_start_ = Vec3::Zero();
   Vec3 leg_dir_ = Vec3::UnitX();
   double leg_length_ = 0;

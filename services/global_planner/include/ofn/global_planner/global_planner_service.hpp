@@ -12,6 +12,7 @@
 #include "ofn/common/config.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/control_status_t.hpp"
 #include "ofn/cuboid_list_t.hpp"
 #include "ofn/global_path_t.hpp"
 #include "ofn/global_planner/global_planner.hpp"

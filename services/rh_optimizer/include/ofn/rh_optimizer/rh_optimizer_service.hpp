@@ -15,6 +15,7 @@
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/warning_streak.hpp"
+#include "ofn/control_status_t.hpp"
 #include "ofn/global_path_t.hpp"
 #include "ofn/map/distance_field.hpp"
 #include "ofn/map/heightfield.hpp"

@@ -25,9 +25,17 @@ struct Waypoint {
   double capture_radius = 0;     // m
 };
 
-/// Index of the waypoint that ends the leg nearest `position` (ties go to
-/// the later leg); 0 for a single waypoint, -1 for none. Where a plan is
-/// picked up mid-route (a restarted controller, the planners).
+/// Legs closer to `position` than the nearest by less than this count as
+/// equally near (the two legs of a route flown out and back lie on one
+/// line, and their distances differ in the last bits).
+inline constexpr double kLegTieDistance = 1e-3;  // m
+
+/// Index of the waypoint that ends the leg nearest `position`; 0 for a
+/// single waypoint, -1 for none. Of equally near legs the earliest wins: a
+/// route that comes back over itself is flown outwards first, and a
+/// vehicle on the waypoint between two legs moves on by the capture rule
+/// of whoever picks the leg up. Where a plan is picked up mid-route (the
+/// start, a restarted controller, the planners).
 inline int nearest_leg(const std::vector<Waypoint>& waypoints, const Vec3& position) {
   if (waypoints.empty()) return -1;
   int best = 0;
@@ -35,7 +43,7 @@ inline int nearest_leg(const std::vector<Waypoint>& waypoints, const Vec3& posit
   for (size_t i = 1; i < waypoints.size(); ++i) {
     const double d =
         distance_to_segment(position, waypoints[i - 1].position, waypoints[i].position);
-    if (d <= best_distance) {
+    if (d < best_distance - kLegTieDistance) {
       best_distance = d;
       best = static_cast<int>(i);
     }
