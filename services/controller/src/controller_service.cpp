@@ -284,10 +284,8 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
 }
 
 void ControllerService::on_solver_stats(const solver_stats_t& m) {
-  const MissionLeg checked{m.mission_id, m.active_waypoint};
   perception_.on_status(to_seconds(m.utime), m.map_utime > 0 ? to_seconds(m.map_utime) : 0.0,
-                        m.guidance_clear, checked);
-  planner_leg_ = checked;
+                        m.guidance_clear, MissionLeg{m.mission_id, m.active_waypoint});
 }
 
 void ControllerService::on_mission(const mission_t& m) {
@@ -469,10 +467,11 @@ void ControllerService::control_step() {
     mission_pending_ = false;
   }
   // Guidance flies the planner's leg (WaypointGuidance::follow_leg).
-  if (mission_ && planner_leg_.mission_id == mission_->mission_id &&
-      guidance_.follow_leg(planner_leg_.waypoint, mode_ == control_status_t::WAYPOINT, x.position,
+  const MissionLeg& planner_leg = perception_.checked();
+  if (mission_ && planner_leg.mission_id == mission_->mission_id &&
+      guidance_.follow_leg(planner_leg.waypoint, mode_ == control_status_t::WAYPOINT, x.position,
                            x.velocity))
-    node_.log().info("on to the planner's leg: waypoint {} at t={:.2f} s", planner_leg_.waypoint,
+    node_.log().info("on to the planner's leg: waypoint {} at t={:.2f} s", planner_leg.waypoint,
                      to_seconds(now));
   const MissionLeg flown{mission_ ? mission_->mission_id : -1, guidance_.active_waypoint()};
   // The governor acts at the limits themselves: the vehicle still overshoots

@@ -89,6 +89,10 @@ TEST(PerceptionWatch, AClearWordHoldsForItsOwnLegOnly) {
     EXPECT_NE(why->find("cleared the leg to waypoint 2 of mission 3"), std::string::npos) << *why;
   }
   EXPECT_FALSE(watch.stale(10.0, MissionLeg{3, 2}));
+  // The leg of the newest status; an older one, reordered, does not count.
+  EXPECT_EQ(watch.checked(), (MissionLeg{3, 2}));
+  watch.on_status(9.9, 9.9, true, MissionLeg{3, 1});
+  EXPECT_EQ(watch.checked(), (MissionLeg{3, 2}));
 }
 
 TEST(PerceptionWatch, DisabledNeverHolds) {

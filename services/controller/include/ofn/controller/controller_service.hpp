@@ -84,8 +84,6 @@ class ControllerService {
   std::optional<ref_traj_t> ref_traj_;
   int8_t mode_ = control_status_t::NAV_STALE;  // until the first navigation arrives
   PathHeadingFilter path_heading_;
-  /// The leg the optimiser last said it checks and plans along.
-  MissionLeg planner_leg_;
   Reference last_ref_;
   bool last_ref_flown_ = false;
   Utime last_flown_step_ = INT64_MIN;  // when last_ref_ was flown

@@ -63,6 +63,9 @@ class PerceptionWatch {
   /// not begun (the controller goes on holding rather than stopping).
   bool confirmed_once() const { return confirmed_once_; }
 
+  /// The leg the newest status was given on (none before one).
+  const MissionLeg& checked() const { return checked_; }
+
   const PerceptionWatchSettings& settings() const { return settings_; }
 
  private:
