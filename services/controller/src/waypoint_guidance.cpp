@@ -5,6 +5,12 @@
 #include <limits>
 
 namespace ofn::control {
+namespace {
+// m; a vehicle this close to the leg is on it (no rejoin segment of
+// vanishing length and undefined direction).
+constexpr double kOnLegTolerance = 1e-3;
+}  // namespace
+
 void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, double cruise_speed,
                                    const Limits& limits, const Vec3& position,
                                    const Vec3& velocity) {
@@ -19,8 +25,6 @@ void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, doubl
   leg_cap_ = std::numeric_limits<int>::max();
   if (waypoints_.empty()) return;
   const int best = nearest_leg(waypoints_, position);
-  // Start the leg at the vehicle's projection onto it, so the reference
-  // does not jump.
   const Vec3 from = best > 0 ? waypoints_[best - 1].position : position;
   start_leg(from, best, 0.0);
   resync(position, velocity);
@@ -28,6 +32,7 @@ void WaypointGuidance::set_mission(const std::vector<Waypoint>& waypoints, doubl
 
 void WaypointGuidance::start_leg(const Vec3& from, int to_index, double speed_along) {
   active_ = to_index;
+  rejoin_.reset();
   leg_start_ = from;
   const Vec3 leg = waypoints_[to_index].position - from;
   leg_length_ = leg.norm();
@@ -35,6 +40,16 @@ void WaypointGuidance::start_leg(const Vec3& from, int to_index, double speed_al
   s_ = 0;
   s_dot_ = std::max(0.0, speed_along);
   s_ddot_ = 0;
+}
+
+void WaypointGuidance::join_leg() {
+  const double beyond = std::max(0.0, s_ - leg_length_);
+  s_dot_ *= std::max(0.0, leg_dir_.dot(rejoin_->leg_dir));
+  leg_start_ = rejoin_->leg_start;
+  leg_dir_ = rejoin_->leg_dir;
+  leg_length_ = rejoin_->leg_length;
+  s_ = std::min(leg_length_, rejoin_->meets_at + beyond);
+  rejoin_.reset();
 }
 
 void WaypointGuidance::next_leg_from_reference() {
@@ -64,7 +79,29 @@ bool WaypointGuidance::follow_leg(int index, bool flying, const Vec3& position,
 
 void WaypointGuidance::resync(const Vec3& position, const Vec3& velocity) {
   if (waypoints_.empty() || active_ < 0) return;
-  s_ = std::clamp((position - leg_start_).dot(leg_dir_), 0.0, leg_length_);
+  if (rejoin_) {  // measured from the leg itself, not from an earlier rejoin
+    leg_start_ = rejoin_->leg_start;
+    leg_dir_ = rejoin_->leg_dir;
+    leg_length_ = rejoin_->leg_length;
+    rejoin_.reset();
+  }
+  const double projection = std::clamp((position - leg_start_).dot(leg_dir_), 0.0, leg_length_);
+  const Vec3 on_leg = leg_start_ + leg_dir_ * projection;
+  if ((position - on_leg).norm() <= kOnLegTolerance) {
+    s_ = projection;
+  } else {
+    // Put on the leg's line, the reference would step by the vehicle's
+    // distance from it (a controller restarted after the vehicle drifted
+    // for seconds: 2 m), and the vehicle would be pulled across at the
+    // controller's bandwidth along a path nobody checked.
+    const double meets_at = std::min(leg_length_, projection + kGuidanceRejoinDistance);
+    const Vec3 segment = leg_start_ + leg_dir_ * meets_at - position;
+    rejoin_ = Rejoin{leg_start_, leg_dir_, leg_length_, meets_at};
+    leg_start_ = position;
+    leg_length_ = segment.norm();
+    leg_dir_ = segment / leg_length_;
+    s_ = 0;
+  }
   s_dot_ = std::clamp(velocity.dot(leg_dir_), 0.0, leg_speed_limit());
   s_ddot_ = 0;
   just_synced_ = true;
@@ -90,12 +127,14 @@ GuidanceReference WaypointGuidance::update(const Vec3& position, const Vec3& vel
   // not past the planner's leg.
   while (!final_leg() && active_ < leg_cap_) {
     const Vec3& target = waypoints_[active_].position;
-    if ((position - target).norm() > waypoints_[active_].capture_radius && s_ < leg_length_ - 1e-9)
-      break;
+    const bool at_leg_end = !rejoin_ && s_ >= leg_length_ - 1e-9;
+    if ((position - target).norm() > waypoints_[active_].capture_radius && !at_leg_end) break;
     next_leg_from_reference();
   }
 
-  const double remaining = leg_length_ - s_;
+  // To the waypoint: the rest of the rejoin, then the leg beyond it.
+  const double remaining =
+      leg_length_ - s_ + (rejoin_ ? rejoin_->leg_length - rejoin_->meets_at : 0.0);
   double target_speed = leg_speed_limit();
   // Rubber band: do not let the reference run away from a vehicle that lags.
   const double along = (position - leg_start_).dot(leg_dir_);
@@ -121,15 +160,18 @@ GuidanceReference WaypointGuidance::update(const Vec3& position, const Vec3& vel
   s_ddot_ = std::clamp(desired, s_ddot_ - jerk * dt, s_ddot_ + jerk * dt);
   s_dot_ = std::max(0.0, s_dot_ + s_ddot_ * dt);
   if (s_dot_ == 0.0 && s_ddot_ < 0) s_ddot_ = 0;
-  s_ = std::min(leg_length_, s_ + s_dot_ * dt);
+  s_ += s_dot_ * dt;
+  if (rejoin_ && s_ >= leg_length_) join_leg();
+  s_ = std::min(leg_length_, s_);
 
   out.position = leg_start_ + leg_dir_ * s_;
   out.velocity = leg_dir_ * s_dot_;
   out.acceleration = leg_dir_ * s_ddot_;
-  out.leg_direction = leg_dir_;
+  // The heading faces along the leg, through a rejoin too.
+  out.leg_direction = rejoin_ ? rejoin_->leg_dir : leg_dir_;
   out.active_waypoint = active_;
   const Waypoint& last = waypoints_.back();
-  if (final_leg() && s_ >= leg_length_ - 1e-6 &&
+  if (final_leg() && !rejoin_ && s_ >= leg_length_ - 1e-6 &&
       (position - last.position).norm() <= last.capture_radius &&
       velocity.norm() <= config_.stop_speed)
     done_ = true;

@@ -92,7 +92,7 @@ TEST(WaypointGuidance, FliesThePlannersLegAndMovesOnWithIt) {
 TEST(WaypointGuidance, APlannerFurtherOnWhilePlansAreFlownGivesTheTrueLeg) {
   // The planner flew the vehicle out and most of the way back; guidance,
   // idle meanwhile, takes up the way back from waypoint 1, with the
-  // reference on the vehicle's projection.
+  // reference on the vehicle, rejoining the leg 15 m further on.
   const std::vector<Waypoint> wps = {
       {Vec3(0, 0, -30), 5.0}, {Vec3(100, 0, -30), 5.0}, {Vec3(0, 0, -30), 5.0}};
   WaypointGuidance g;
@@ -102,9 +102,10 @@ TEST(WaypointGuidance, APlannerFurtherOnWhilePlansAreFlownGivesTheTrueLeg) {
   ASSERT_TRUE(g.follow_leg(2, false, vehicle, Vec3(-3, 0, 0)));
   const GuidanceReference r = g.update(vehicle, Vec3(-3, 0, 0), kDt);
   EXPECT_EQ(r.active_waypoint, 2);
-  EXPECT_TRUE(r.position.isApprox(Vec3(30, 0, -30), 1e-9));
+  EXPECT_TRUE(r.position.isApprox(vehicle, 1e-9));
+  const Vec3 rejoin = (Vec3(30 - kGuidanceRejoinDistance, 0, -30) - vehicle).normalized();
   EXPECT_TRUE(r.leg_direction.isApprox(Vec3(-1, 0, 0), 1e-9));
-  EXPECT_NEAR(r.velocity.x(), -3.0, 1e-9);
+  EXPECT_NEAR(r.velocity.dot(rejoin), 3.0 * -rejoin.x(), 1e-9);
 }
 
 TEST(WaypointGuidance, WithoutMissionGivesNoWaypoint) {
@@ -216,11 +217,13 @@ TEST(WaypointGuidance, RestartMidLegPicksUpTheLegTheVehicleIsOn) {
   g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), position, velocity);
   const GuidanceReference r = g.update(position, velocity, kDt);
   EXPECT_EQ(r.active_waypoint, 2);
-  // No jump: the reference starts at the vehicle's projection on the leg,
-  // not a step ahead of it, moving at the vehicle's speed along it.
-  EXPECT_LT((r.position - Vec3(50, 24, -30)).norm(), 1e-9);
+  // No jump: the reference starts on the vehicle, not a step ahead of it
+  // nor on the leg beside it, moving at the vehicle's speed along the
+  // rejoin to the leg.
+  EXPECT_LT((r.position - position).norm(), 1e-9);
   EXPECT_NEAR(r.velocity.y(), 3.0, 0.05);
   EXPECT_TRUE(r.leg_direction.isApprox(Vec3::UnitY()));
+  EXPECT_TRUE(r.velocity.normalized().isApprox((Vec3(50, 39, -30) - position).normalized()));
 }
 
 TEST(WaypointGuidance, ResyncStartsOnTheVehicleThenAdvances) {
@@ -231,14 +234,54 @@ TEST(WaypointGuidance, ResyncStartsOnTheVehicleThenAdvances) {
   WaypointGuidance g;
   g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), wps[0].position, Vec3::Zero());
   for (int i = 0; i < 100; ++i) g.update(wps[0].position, Vec3::Zero(), kDt);
-  const Vec3 position(80, 2, -30), velocity(2.5, 0, 0);  // below the cruise
+  const Vec3 position(80, 0, -30), velocity(2.5, 0, 0);  // below the cruise
   g.resync(position, velocity);
   const GuidanceReference first = g.update(position, velocity, kDt);
-  EXPECT_LT((first.position - Vec3(80, 0, -30)).norm(), 1e-9);
+  EXPECT_LT((first.position - position).norm(), 1e-9);
   EXPECT_NEAR(first.velocity.x(), 2.5, 1e-9);
   const GuidanceReference second = g.update(position + velocity * kDt, velocity, kDt);
   EXPECT_GT(second.position.x(), 80 + 2.5 * kDt);  // on, speeding up toward the cruise
   EXPECT_LT(second.position.x(), 80 + 3.0 * kDt);
+}
+
+TEST(WaypointGuidance, OffTheLegItRejoinsAlongTheCheckedSegmentWithoutAJump) {
+  // A controller restarted after the vehicle drifted 2 m beside and 1 m
+  // below the leg: the reference starts on the vehicle and flies the
+  // straight segment to the leg kGuidanceRejoinDistance ahead (the path
+  // the RH optimiser checks), then the leg, and never steps.
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(200, 0, -30), 2.0}};
+  const Vec3 start(60, -2, -29);
+  PerfectFollower f(wps, 3.0, limits(3.0, 0.5, 1.0), start);
+  ASSERT_TRUE(f.run(120));
+  EXPECT_LT((f.refs.front().position - start).norm(), 1e-9);
+  const Vec3 meet(60 + kGuidanceRejoinDistance, 0, -30);
+  bool met = false;
+  for (size_t i = 0; i < f.refs.size(); ++i) {
+    const Vec3& p = f.refs[i].position;
+    if (i > 0) {
+      EXPECT_LE((p - f.refs[i - 1].position).norm(), 3.0 * kDt + 1e-9) << i;
+    }
+    if (p.x() < meet.x() - 1e-9) {
+      EXPECT_LT(distance_to_segment(p, start, meet), 1e-9) << p.transpose();
+    } else {
+      met = true;
+      EXPECT_LT(std::hypot(p.y(), p.z() + 30), 1e-9) << p.transpose();
+    }
+  }
+  EXPECT_TRUE(met);
+  EXPECT_LT((f.refs.back().position - wps[1].position).norm(), 1e-6);
+}
+
+TEST(WaypointGuidance, OffTheLegBesideTheLastWaypointItRejoinsAtTheWaypoint) {
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(100, 0, -30), 2.0}};
+  const Vec3 start(95, 3, -30);  // the leg ends 5 m on: the rejoin goes to its end
+  PerfectFollower f(wps, 3.0, limits(3.0, 0.5, 1.0), start);
+  ASSERT_TRUE(f.run(60));
+  EXPECT_LT((f.refs.front().position - start).norm(), 1e-9);
+  for (const GuidanceReference& r : f.refs) {
+    EXPECT_LT(distance_to_segment(r.position, start, wps[1].position), 1e-9);
+  }
+  EXPECT_LT((f.refs.back().position - wps[1].position).norm(), 1e-6);
 }
 
 TEST(WaypointGuidance, RestartNearTheFirstLegStartsThere) {

@@ -34,7 +34,7 @@ NominalCheck check_nominal_path(const ClearanceQuery& clearance, const Leg& leg,
   const Vec3 u = length > 1e-9 ? Vec3(d / length) : Vec3::UnitX();
   const double along = std::clamp((position - leg.from).dot(u), 0.0, length);
   const double end = std::min(length, along + lookahead);
-  const double rejoin = std::min(end, along + s.rejoin_distance);
+  const double rejoin = std::min(end, along + kGuidanceRejoinDistance);
   const double step = std::max(0.1, s.check_spacing);
   auto check = [&](const Vec3& p, double travelled) {
     const double c = clearance(p).distance;

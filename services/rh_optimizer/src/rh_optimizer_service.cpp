@@ -198,7 +198,6 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   YamlReader a = r.child("avoidance");
   SwitchSettings& w = c.avoidance;
   w.engage_margin = a.number_in("engage_margin", w.engage_margin, 0.0, 100.0);
-  w.rejoin_distance = a.number_in("rejoin_distance", w.rejoin_distance, 0.0, 1000.0);
   w.check_spacing = a.number_in("check_spacing", w.check_spacing, 0.1, 10.0);
   w.handback_distance = a.number_in("handback_distance", w.handback_distance, 0.0, 100.0);
   w.handback_hold = a.number_in("handback_hold", w.handback_hold, 0.0, 60.0);

@@ -6,10 +6,13 @@
 // With a planner, the leg flown is the planner's (follow_leg): guidance
 // flies only what the planner has checked, and where legs lie over each
 // other (a route flown out and back) the vehicle's position alone cannot
-// say which is meant.
+// say which is meant. A leg taken up from a vehicle off it is rejoined
+// along the straight segment the RH optimiser checks before guidance may
+// fly (kGuidanceRejoinDistance): the reference never jumps onto the leg.
 // Pure core: positions in world NED, SI units.
 
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "ofn/common/frames.hpp"
@@ -40,7 +43,8 @@ class WaypointGuidance {
   explicit WaypointGuidance(GuidanceConfig config = {}) : config_(config) {}
 
   /// Starts a plan. The first leg is the one nearest the vehicle, so a
-  /// controller restarted mid-flight picks up where the vehicle is.
+  /// controller restarted mid-flight picks up where the vehicle is; the
+  /// reference starts on the vehicle (resync).
   void set_mission(const std::vector<Waypoint>& waypoints, double cruise_speed,
                    const Limits& limits, const Vec3& position, const Vec3& velocity);
   void clear() { waypoints_.clear(); }
@@ -48,8 +52,13 @@ class WaypointGuidance {
   /// Index of the waypoint flown to; -1 without a mission.
   int active_waypoint() const { return waypoints_.empty() ? -1 : active_; }
 
-  /// Puts the reference back at the vehicle's projection on the active leg,
-  /// after another source of reference (avoidance) has been flown.
+  /// Puts the reference back on the vehicle, after another source of
+  /// reference (a plan, a stop, a hold) has been flown or none was: on the
+  /// vehicle's projection when it is on the active leg, otherwise at the
+  /// start of a straight rejoin from the vehicle to the leg
+  /// kGuidanceRejoinDistance ahead of that projection (or to the leg's end,
+  /// if nearer), the path the RH optimiser checked. The speed along is the
+  /// vehicle's.
   void resync(const Vec3& position, const Vec3& velocity);
 
   /// The planner checks and plans along the leg to waypoint `index`:
@@ -72,6 +81,9 @@ class WaypointGuidance {
 
  private:
   void start_leg(const Vec3& from, int to_index, double speed_along);
+  /// From the end of a rejoin on along the leg it met, keeping the part of
+  /// the speed that lies along the leg.
+  void join_leg();
   /// On to the next leg from where the reference is, keeping the part of
   /// its speed that lies along the new leg.
   void next_leg_from_reference();
@@ -84,9 +96,17 @@ class WaypointGuidance {
   Limits limits_;
   int active_ = -1;
   int leg_cap_ = std::numeric_limits<int>::max();  // the planner's leg; no cap without one
+  // The straight piece the reference is on: the leg to waypoint active_,
+  // or while rejoining it, the rejoin segment.
   Vec3 leg_start_ = Vec3::Zero();
   Vec3 leg_dir_ = Vec3::UnitX();
   double leg_length_ = 0;
+  struct Rejoin {
+    Vec3 leg_start, leg_dir;
+    double leg_length;
+    double meets_at;  // m along the leg where the rejoin segment ends
+  };
+  std::optional<Rejoin> rejoin_;  // the leg being rejoined, while it is
   double s_ = 0, s_dot_ = 0, s_ddot_ = 0;
   bool just_synced_ = false;
   bool done_ = false;

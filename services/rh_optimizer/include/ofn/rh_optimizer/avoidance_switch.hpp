@@ -6,9 +6,8 @@
 // ahead, then fly along it. Avoidance engages as soon as that path, within
 // sensor range, passes closer to a detected obstacle than the clearance. It
 // hands back only when that path has been clear for a while AND the vehicle
-// is back near the leg: waypoint guidance resumes from the vehicle's
-// projection on the leg, so handing back far from it would command a jump
-// the acceleration limit does not allow.
+// is back near the leg: waypoint guidance resumes from the vehicle along the
+// rejoin segment, which is short and shallow only near the leg.
 
 #include "ofn/common/frames.hpp"
 #include "ofn/map/heightfield.hpp"
@@ -18,7 +17,6 @@ namespace ofn::rh {
 
 struct SwitchSettings {
   double engage_margin = 0.5;      // m beyond the clearance the nominal path must keep
-  double rejoin_distance = 15.0;   // m ahead along the leg where nominal guidance rejoins it
   double check_spacing = 1.0;      // m between checked points of the nominal path
   double handback_distance = 0.3;  // m from the leg within which avoidance may hand back
   double handback_hold = 1.0;      // s the nominal path must stay clear before handing back
@@ -41,7 +39,7 @@ struct NominalCheck {
 };
 
 /// The nominal path from `position`: the rejoin segment to the leg
-/// `rejoin_distance` ahead of the vehicle's projection, then the leg up to
+/// kGuidanceRejoinDistance ahead of the vehicle's projection, then the leg up to
 /// `lookahead` ahead of the projection or its end, checked against
 /// `required` clearance.
 NominalCheck check_nominal_path(const ClearanceQuery& clearance, const Leg& leg,

@@ -30,6 +30,14 @@ struct Waypoint {
 /// line, and their distances differ in the last bits).
 inline constexpr double kLegTieDistance = 1e-3;  // m
 
+/// How nominal waypoint guidance takes up a leg from a vehicle that is off
+/// it (a restarted controller, the end of a stop, a hold or an avoidance):
+/// a straight rejoin from the vehicle to the leg this far ahead of the
+/// vehicle's projection on it (or to the leg's end, if nearer), then the
+/// leg. The RH optimiser checks exactly that path before guidance may fly
+/// (rh::check_nominal_path): one value for both.
+inline constexpr double kGuidanceRejoinDistance = 15.0;  // m
+
 /// Index of the waypoint that ends the leg nearest `position`; 0 for a
 /// single waypoint, -1 for none. Of equally near legs the earliest wins: a
 /// route that comes back over itself is flown outwards first, and a
