@@ -1,11 +1,17 @@
 #!/usr/bin/python3
 """Seeded random obstacle fields over the benchmark course, written as scenario YAML.
 
-Usage: random_field.py --seed S --out FILE [--dense] [--template sim/scenarios/bench1.yaml]
+Usage: random_field.py --seed S --out FILE [--dense | --trap] [--out-and-back]
+                       [--template sim/scenarios/bench1.yaml]
 
 The course (start, goal waypoint, limits, gates, max_time, units) is copied
 from the template, bench1 by default; only the obstacles are drawn. The same
 seed, class and template always give the same file, byte for byte.
+With --out-and-back the course goes on from the goal back to the first
+waypoint (one more waypoint, with the goal's capture radius, and twice the
+time limit): the same obstacles, flown both ways over one line, so that
+the legs of a route of several legs are exercised. The gates still time
+the way out.
 
 Two classes of field (../shared/BENCHMARKS.md): "fair" fields (the default),
 in which a route with R_s clearance always exists, and "dense" fields
@@ -90,6 +96,7 @@ pop-up as well. Like dense fields they may be sealed (the baseline says).
   within 40 <= x <= 380 (the run-up and run-out stay clear); the wall may
   reach far beyond |y| = 160. max_time is 300 s (a wall's end may be far).
 """
+import copy
 import math
 import os
 import random
@@ -547,8 +554,25 @@ def _vec(v):
     return "[" + ", ".join(_num(float(x)) for x in v) + "]"
 
 
-def field_yaml(seed, obstacles, tpl, template_name, kind="fair"):
-    """Scenario text in the bench file layout; `kind` is fair, dense or trap."""
+def out_and_back(tpl):
+    """The template's course flown out and back: a last waypoint at the first one, with the
+    goal's capture radius, and twice the time limit."""
+    course = copy.deepcopy(tpl)
+    waypoints = course["waypoints"]
+    back = {"position": list(waypoints[0]["position"])}
+    if "capture_radius" in waypoints[-1]:
+        back["capture_radius"] = waypoints[-1]["capture_radius"]
+    waypoints.append(back)
+    if "max_time" in course:
+        course["max_time"] = 2.0 * float(course["max_time"])
+    return course
+
+
+def field_yaml(seed, obstacles, tpl, template_name, kind="fair", both_ways=False):
+    """Scenario text in the bench file layout; `kind` is fair, dense or trap; `both_ways`: the
+    course out and back (out_and_back)."""
+    if both_ways:
+        tpl = out_and_back(tpl)
     start, lim, gates = tpl["start"], tpl["limits"], tpl["gates"]
     tall = sum(1 for o in obstacles if is_tall(o))
     if kind == "trap":
@@ -580,6 +604,14 @@ def field_yaml(seed, obstacles, tpl, template_name, kind="fair"):
             "name: field-%d" % seed,
             "description: random field %d, %d obstacles (%d tall)" % (seed, len(obstacles), tall),
         ]
+    if both_ways:
+        for i, line in enumerate(head):
+            if line.startswith("# Regenerate:"):
+                head[i] = line.replace(" --out FILE", " --out-and-back --out FILE")
+            elif line.startswith("name: "):
+                head[i] = line + "-out-and-back"
+            elif line.startswith("description: "):
+                head[i] = line + ", flown out and back"
     lines = head + [
         "units: %s" % tpl["units"],
         "start:",
@@ -617,7 +649,7 @@ def field_yaml(seed, obstacles, tpl, template_name, kind="fair"):
         if "appear_time" in ob:
             lines.append("    appear_time: %s   # s; seen before it can be reached" % _num(ob["appear_time"]))
     if kind == "trap":
-        lines.append("max_time: %s" % _num(TRAP_MAX_TIME))
+        lines.append("max_time: %s" % _num(TRAP_MAX_TIME * (2 if both_ways else 1)))
     elif "max_time" in tpl:
         lines.append("max_time: %s" % _num(float(tpl["max_time"])))
     return "\n".join(lines) + "\n"
@@ -626,11 +658,11 @@ def field_yaml(seed, obstacles, tpl, template_name, kind="fair"):
 GENERATORS = {"fair": generate, "dense": generate_dense, "trap": generate_trap}
 
 
-def write_field(seed, path, template=DEFAULT_TEMPLATE, kind="fair"):
+def write_field(seed, path, template=DEFAULT_TEMPLATE, kind="fair", both_ways=False):
     """Write the field of `seed` of `kind` (fair, dense or trap) to `path`; returns its obstacle list."""
     tpl = load_template(template)
     obstacles, _ = GENERATORS[kind](seed, tpl)
-    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO), kind)
+    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO), kind, both_ways)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w") as f:
         f.write(text)
@@ -650,6 +682,7 @@ def build_parser():
                "  bench/random_field.py --dense --seed 7 --template sim/scenarios/bench1.yaml \\\n"
                "      --out /tmp/dense-7.yaml\n"
                "  bench/random_field.py --trap --seed 7 --out /tmp/trap-7.yaml\n"
+               "  bench/random_field.py --dense --out-and-back --seed 7 --out /tmp/dense-7-back.yaml\n"
                "\n"
                "Exit codes: 0 when the field is written; 2 for bad arguments, an unusable\n"
                "template, a file that cannot be written or PyYAML missing.")
@@ -666,6 +699,9 @@ def build_parser():
     kind.add_argument("--trap", action="store_true",
                       help="a trap field (a dead end, a wall wider than the map or a narrow "
                            "pocket, clutter, sometimes a pop-up; may be sealed) (default: fair)")
+    ap.add_argument("--out-and-back", action="store_true",
+                    help="the course goes on from the goal back to the first waypoint, with the "
+                         "same obstacles and twice the time limit (default: out only)")
     return ap
 
 
@@ -677,7 +713,8 @@ def field_kind(args):
 def main(argv=None):
     args = build_parser().parse_args(argv)
     try:
-        obstacles = write_field(args.seed, args.out, args.template, field_kind(args))
+        obstacles = write_field(args.seed, args.out, args.template, field_kind(args),
+                                args.out_and_back)
     except OSError as exc:
         print("%s: error: %s: %s" % (PROG, exc.filename or args.out, exc.strerror), file=sys.stderr)
         return cr.EXIT_USAGE

@@ -112,6 +112,27 @@ class FieldRules(unittest.TestCase):
                 with open(a) as fa, open(b) as fb:
                     self.assertEqual(fa.read(), fb.read(), kind)
 
+    def test_out_and_back_adds_the_way_home_to_the_same_field(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            for kind in ("fair", "dense", "trap"):
+                one, both = os.path.join(tmp, kind + "-out.yaml"), os.path.join(tmp, kind + "-back.yaml")
+                rf.write_field(11, one, kind=kind)
+                rf.write_field(11, both, kind=kind, both_ways=True)
+                with open(one) as f:
+                    out = yaml.safe_load(f)
+                with open(both) as f:
+                    back = yaml.safe_load(f)
+                self.assertEqual(back["obstacles"], out["obstacles"], kind)
+                self.assertEqual(back["waypoints"][:-1], out["waypoints"], kind)
+                self.assertEqual(len(back["waypoints"]), len(out["waypoints"]) + 1, kind)
+                home = back["waypoints"][-1]
+                self.assertEqual(home["position"], out["waypoints"][0]["position"], kind)
+                self.assertEqual(home["capture_radius"], out["waypoints"][-1]["capture_radius"], kind)
+                self.assertEqual(back["max_time"], 2 * out["max_time"], kind)
+                self.assertEqual(back["name"], out["name"] + "-out-and-back", kind)
+                for key in ("start", "limits", "gates"):
+                    self.assertEqual(back[key], out[key], kind)
+
     def test_a_trap_file_is_a_scenario_with_its_pop_up_and_time_limit(self):
         with tempfile.TemporaryDirectory() as tmp:
             seed = next(s for s in TRAP_SEEDS
