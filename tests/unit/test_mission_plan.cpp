@@ -24,6 +24,7 @@ TEST(LegTracker, StartsOnTheNearestLeg) {
   EXPECT_EQ(leg->index, 1);
   EXPECT_FALSE(leg->final);
   EXPECT_TRUE(leg->from.isApprox(Vec3(0, 0, -30)));
+  EXPECT_DOUBLE_EQ(leg->capture_radius, 5.0);
 
   LegTracker late;
   late.set_plan(kPlan, dogleg(), Vec3(99, 60, -30));

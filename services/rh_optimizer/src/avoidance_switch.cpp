@@ -81,8 +81,8 @@ double terminal_x(const GuidanceFrame& frame, const mapping::Heightfield& grid,
   return std::min(xf, x_max);
 }
 
-bool AvoidanceSwitch::update(double time, bool conflict, double cross_track,
-                             double stopping_speed) {
+bool AvoidanceSwitch::update(double time, bool conflict, double cross_track, double stopping_speed,
+                             bool at_last_waypoint) {
   if (conflict) {
     engaged_ = true;
     clear_since_ = -1;
@@ -91,7 +91,8 @@ bool AvoidanceSwitch::update(double time, bool conflict, double cross_track,
   if (!engaged_) return false;
   if (clear_since_ < 0) clear_since_ = time;
   if (time - clear_since_ >= settings_.handback_hold &&
-      cross_track <= settings_.handback_distance && stopping_speed <= settings_.handback_stop_speed)
+      (cross_track <= settings_.handback_distance || at_last_waypoint) &&
+      stopping_speed <= settings_.handback_stop_speed)
     reset();
   return engaged_;
 }

@@ -118,6 +118,27 @@ TEST(AvoidanceSwitch, StoppingAtTheLastWaypointHandsBackOnlyWhenSlow) {
   EXPECT_FALSE(sw.update(3.5, false, 0.0, 0.2));
 }
 
+TEST(AvoidanceSwitch, AtRestInsideTheLastWaypointsRadiusItHandsBackOffTheLegToo) {
+  // An out-and-back dense field: the stop at the start ended 0.37 m from
+  // the leg's line (handback_distance 0.3 m), and the optimiser hovered
+  // there, looking around, for 250 s. Inside the waypoint's capture radius
+  // the distance from the line no longer holds the hand-back.
+  SwitchSettings s;
+  s.handback_hold = 1.0;
+  s.handback_distance = 0.3;
+  s.handback_stop_speed = 0.3;
+  AvoidanceSwitch sw(s);
+  EXPECT_TRUE(sw.update(0.0, true, 0.0));
+  EXPECT_TRUE(sw.update(0.1, false, 0.37, 0.05));
+  EXPECT_TRUE(sw.update(5.0, false, 0.37, 0.05));       // outside the radius: held
+  EXPECT_TRUE(sw.update(5.1, false, 0.37, 0.5, true));  // inside, still too fast
+  EXPECT_FALSE(sw.update(5.2, false, 0.37, 0.05, true));
+  // Still only when clear.
+  AvoidanceSwitch conflicted(s);
+  EXPECT_TRUE(conflicted.update(0.0, true, 0.37, 0.05, true));
+  EXPECT_TRUE(conflicted.update(5.0, true, 0.37, 0.05, true));
+}
+
 TEST(DeferFirstBrake, OnlyWhileTheConflictIsBeyondTheStopAndTheMargin) {
   // At 3 m/s braking at 0.39 m/s^2 the stop (onset and ease-out included)
   // takes about 12.3 m; with a 10 m margin a conflict 30 m on is deferred,

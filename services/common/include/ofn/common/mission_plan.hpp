@@ -39,10 +39,11 @@ inline Limits limits_from(const limits_t& l) {
 }
 
 struct ActiveLeg {
-  Vec3 from = Vec3::Zero();  // previous waypoint (or where the plan was picked up)
-  Vec3 to = Vec3::Zero();    // the waypoint flown to
-  int index = -1;            // index of `to` in the plan
-  bool final = false;        // `to` is the last waypoint
+  Vec3 from = Vec3::Zero();   // previous waypoint (or where the plan was picked up)
+  Vec3 to = Vec3::Zero();     // the waypoint flown to
+  int index = -1;             // index of `to` in the plan
+  bool final = false;         // `to` is the last waypoint
+  double capture_radius = 0;  // m, of `to`
 };
 
 class LegTracker {
@@ -83,6 +84,7 @@ class LegTracker {
     leg.to = waypoints_[active_].position;
     leg.from = active_ > 0 ? waypoints_[active_ - 1].position : single_from_;
     leg.final = active_ + 1 == static_cast<int>(waypoints_.size());
+    leg.capture_radius = waypoints_[active_].capture_radius;
     return leg;
   }
 
