@@ -637,8 +637,10 @@ void RhOptimizerService::tick() {
   const bool was_engaged = switch_.engaged();
   const double t = to_seconds(now);
   const double stopping_speed = stopping_at_target_ ? velocity.norm() : 0.0;
-  const bool at_last_waypoint =
-      active->final && (position - active->to).norm() <= active->capture_radius;
+  // Only while the plan stops there, so that the switch asks for rest
+  // (stopping_speed): handed back at speed so near, guidance overshoots.
+  const bool at_last_waypoint = stopping_at_target_ && active->final &&
+                                (position - active->to).norm() <= active->capture_radius;
   const bool engaged = switch_.update(t, conflict, cross_track_distance(leg, position),
                                       stopping_speed, at_last_waypoint);
   const RecoveryDecision recovery = update_recovery(now, leg, limits, position, velocity, engaged);

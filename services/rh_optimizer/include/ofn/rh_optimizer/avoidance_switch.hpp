@@ -74,8 +74,9 @@ class AvoidanceSwitch {
   /// One decision at `time` (s). conflict: the nominal path is too close to
   /// an obstacle now. cross_track: the vehicle's distance from the leg (m).
   /// stopping_speed: its speed while avoidance is stopping it at the last
-  /// waypoint, 0 otherwise. at_last_waypoint: the vehicle is inside the
-  /// last waypoint's capture radius; near the leg or not, guidance may then
+  /// waypoint, 0 otherwise. at_last_waypoint: avoidance is stopping the
+  /// vehicle at the last waypoint and it is inside the waypoint's capture
+  /// radius; near the leg or not, guidance may then
   /// take over (its rejoin goes straight to the waypoint, the nominal path
   /// checked), so that a stop that ended a little beside the leg's line is
   /// not held for ever. Returns whether avoidance is engaged after it.
