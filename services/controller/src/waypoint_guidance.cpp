@@ -42,14 +42,19 @@ void WaypointGuidance::start_leg(const Vec3& from, int to_index, double speed_al
   s_ddot_ = 0;
 }
 
-void WaypointGuidance::join_leg() {
-  const double beyond = std::max(0.0, s_ - leg_length_);
-  s_dot_ *= std::max(0.0, leg_dir_.dot(rejoin_->leg_dir));
+void WaypointGuidance::back_on_leg() {
   leg_start_ = rejoin_->leg_start;
   leg_dir_ = rejoin_->leg_dir;
   leg_length_ = rejoin_->leg_length;
-  s_ = std::min(leg_length_, rejoin_->meets_at + beyond);
   rejoin_.reset();
+}
+
+void WaypointGuidance::join_leg() {
+  const double beyond = std::max(0.0, s_ - leg_length_);
+  const double meets_at = rejoin_->meets_at;
+  s_dot_ *= std::max(0.0, leg_dir_.dot(rejoin_->leg_dir));
+  back_on_leg();
+  s_ = std::min(leg_length_, meets_at + beyond);
 }
 
 void WaypointGuidance::next_leg_from_reference() {
@@ -79,12 +84,7 @@ bool WaypointGuidance::follow_leg(int index, bool flying, const Vec3& position,
 
 void WaypointGuidance::resync(const Vec3& position, const Vec3& velocity) {
   if (waypoints_.empty() || active_ < 0) return;
-  if (rejoin_) {  // measured from the leg itself, not from an earlier rejoin
-    leg_start_ = rejoin_->leg_start;
-    leg_dir_ = rejoin_->leg_dir;
-    leg_length_ = rejoin_->leg_length;
-    rejoin_.reset();
-  }
+  if (rejoin_) back_on_leg();  // measured from the leg itself, not from an earlier rejoin
   const double projection = std::clamp((position - leg_start_).dot(leg_dir_), 0.0, leg_length_);
   const Vec3 on_leg = leg_start_ + leg_dir_ * projection;
   if ((position - on_leg).norm() <= kOnLegTolerance) {

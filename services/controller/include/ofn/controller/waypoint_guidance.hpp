@@ -81,6 +81,8 @@ class WaypointGuidance {
 
  private:
   void start_leg(const Vec3& from, int to_index, double speed_along);
+  /// The piece the reference is on becomes the leg being rejoined again.
+  void back_on_leg();
   /// From the end of a rejoin on along the leg it met, keeping the part of
   /// the speed that lies along the leg.
   void join_leg();
