@@ -12,6 +12,7 @@
 #include <set>
 #include <vector>
 
+#include "dijkstra.hpp"
 #include "ofn/global_planner/box_grid.hpp"
 #include "ofn/global_planner/cuboid_graph.hpp"
 #include "ofn/global_planner/graph_search.hpp"
@@ -216,21 +217,9 @@ TEST(CuboidGraph, AStartInsideTheClearanceMayLeaveButNotCrossTheCuboid) {
 
 // Dijkstra over every segment the graph's blocked() allows, any direction.
 double dijkstra_any_direction(CuboidGraph& graph) {
-  const int n = graph.size();
-  std::vector<double> dist(n, kInf);
-  std::vector<char> done(n, 0);
-  dist[0] = 0.0;
-  for (int round = 0; round < n; ++round) {
-    int u = -1;
-    for (int i = 0; i < n; ++i)
-      if (!done[i] && (u < 0 || dist[i] < dist[u])) u = i;
-    if (u < 0 || dist[u] == kInf) break;
-    done[u] = 1;
-    for (int v = 1; v < n; ++v)
-      if (v != u && !done[v] && !graph.blocked(u, v))
-        dist[v] = std::min(dist[v], dist[u] + graph.length(u, v));
-  }
-  return dist[1];
+  return test::dijkstra(graph.size(), [&](int u, int v) {
+    return v == 0 || v == u || graph.blocked(u, v) ? kInf : graph.length(u, v);
+  });
 }
 
 TEST(GraphSearch, AnyDirectionFindsWhatDijkstraFindsAndNeverCostsMoreThanForward) {

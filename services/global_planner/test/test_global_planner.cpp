@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "dijkstra.hpp"
 #include "ofn/global_planner/global_planner.hpp"
 
 namespace ofn::planning {
@@ -39,22 +40,9 @@ PlanRequest course_request(std::vector<ObstacleBox> obstacles) {
   return r;
 }
 
-// Independent shortest path over the evaluated graph: plain O(n^2) Dijkstra.
+// Independent shortest path over the evaluated graph.
 double dijkstra(const PlanGraph& graph) {
-  const int n = graph.size();
-  std::vector<double> dist(n, kInf);
-  std::vector<char> done(n, 0);
-  dist[0] = 0.0;
-  for (int round = 0; round < n; ++round) {
-    int u = -1;
-    for (int i = 0; i < n; ++i)
-      if (!done[i] && (u < 0 || dist[i] < dist[u])) u = i;
-    if (u < 0 || dist[u] == kInf) break;
-    done[u] = 1;
-    for (int v = 0; v < n; ++v)
-      if (graph.at(u, v) < kInf) dist[v] = std::min(dist[v], dist[u] + graph.at(u, v));
-  }
-  return dist[1];
+  return test::dijkstra(graph.size(), [&](int u, int v) { return graph.at(u, v); });
 }
 
 // Eq. 10 in the guidance frame: the cubic from one node to the next with
