@@ -183,6 +183,9 @@ def fly_field(args, seed, template):
         "success": campaign.flight_ok(rec), "outcome": campaign.flight_outcome(rec),
         "failures": list(s.get("failures") or []) + ([rec["error"]] if rec.get("error") else []),
         "gate_to_gate_s": s.get("gate_to_gate"),
+        # The verdict times the gates; whether the flight then also reached
+        # its last waypoint (a hover short of it would pass unseen).
+        "reached_last_waypoint": s.get("reached_last_waypoint"),
         "min_clearance_over_rs": s["min_clearance"] / rs if rs and s.get("min_clearance") is not None else None,
         "min_clearance": s["min_clearance"] * k if s.get("min_clearance") is not None else None,
         "max_speed": s["max_speed"] * k if s.get("max_speed") is not None else None,
@@ -327,6 +330,8 @@ def write_report(args, runs, ctx):
         violations = sum(1 for r in runs if r["clearance_violation"])
         excursions = sum(1 for r in runs if r["envelope_excursion"])
         failed_n = sum(1 for r in runs if r["failed"])
+        reached = [r for r in runs if r.get("reached_last_waypoint")]
+        short = [r for r in runs if not r.get("reached_last_waypoint")]
         goal_met = r_rate is not None and r_rate >= DENSE_SUCCESS_GOAL
         lines += [
             "| fields whose baseline finds a route | %d of %d |" % (len(routed), n),
@@ -347,12 +352,15 @@ def write_report(args, runs, ctx):
                 len(finite), ratio_basis, cr.fmt(median(finite), 3), cr.fmt(percentile(finite, 0.95), 3),
                 cr.fmt(max(finite, default=None), 3)),
             "| fields failed | **%d** of %d |" % (failed_n, n),
+            "| last waypoint reached | %d of %d%s |" % (
+                len(reached), n, "" if not short else " (not: seeds %s)" % ", ".join(
+                    str(r["seed"]) for r in short)),
         ]
         doc.update(routed=len(routed), routed_successes=routed_ok, routed_success_rate=r_rate,
                    routed_wilson95=[r_lo, r_hi], goal=DENSE_SUCCESS_GOAL, goal_met=goal_met,
                    sealed=len(sealed), no_baseline_verdict=len(unknown),
                    clearance_violations=violations, envelope_excursions=excursions, failed=failed_n,
-                   ratio_median=median(finite), ratio_p95=percentile(finite, 0.95))
+                   reached_last_waypoint=len(reached), ratio_median=median(finite), ratio_p95=percentile(finite, 0.95))
     else:
         lines += [
             "| success rate | **%.1f %%** (%d of %d) |" % (100 * rate, ok, n),
@@ -567,6 +575,7 @@ def main(argv=None):
               % (doc["routed"], doc["routed_successes"],
                  "" if doc["routed_success_rate"] is None else " (%.1f %%)" % (100 * doc["routed_success_rate"]),
                  doc["sealed"], doc["no_baseline_verdict"]))
+        print("last waypoint reached: %d of %d" % (doc["reached_last_waypoint"], len(runs)))
         print("clearance violations %d, envelope excursions %d, time ratio of the successes: median %s, "
               "95th percentile %s; %.0f s wall, %.1f s per field"
               % (doc["clearance_violations"], doc["envelope_excursions"], cr.fmt(doc["ratio_median"], 3),
