@@ -253,6 +253,12 @@ std::string validate(const solver_stats_t& m) {
   const double v[3] = {m.solve_time, m.max_constraint_violation, m.cost};
   if (!all_finite(v)) return "statistics not finite";
   if (m.active_waypoint < -1) return "active waypoint below -1";
+  // The map a status was checked on is older than the status; a map stamp
+  // ahead of it would count as fresh for that long (guidance, the sweep).
+  // 1 s allows for the hosts' clocks, as a node's max_future does.
+  constexpr int64_t kMapAheadOfStatus = 1000000;  // us
+  if (m.map_utime > m.utime + kMapAheadOfStatus)
+    return "map stamped more than 1 s after the status";
   return "";
 }
 

@@ -454,6 +454,13 @@ TEST(Validate, OtherTypesRejectTheirBadCases) {
   solver_stats_t s = good_stats();
   s.cost = kInf;
   EXPECT_NE(validate(s), "");
+  // A map stamped after the status that names it: up to the 1 s the hosts'
+  // clocks may differ by, accepted.
+  s = good_stats();
+  s.map_utime = s.utime + 1000000;
+  EXPECT_EQ(validate(s), "");
+  s.map_utime = s.utime + 1000001;
+  EXPECT_NE(validate(s), "");
 
   control_status_t st = good_status();
   st.position_error[0] = kNaN;
