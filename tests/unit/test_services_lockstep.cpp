@@ -19,14 +19,12 @@
 #include "ofn/common/scenario.hpp"
 #include "ofn/common/validate/actuator_cmd.hpp"
 #include "ofn/common/validate/control_status.hpp"
-#include "ofn/common/validate/lidar_scan.hpp"
 #include "ofn/common/validate/mission.hpp"
 #include "ofn/common/validate/nav_state.hpp"
 #include "ofn/common/validate/ref_traj.hpp"
 #include "ofn/common/validate/sim_clock.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/controller/controller_service.hpp"
-#include "ofn/lidar_scan_t.hpp"
 #include "ofn/mission_uplink/mission_uplink_service.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/solver_stats_t.hpp"
@@ -60,9 +58,9 @@ struct FlightResult {
 };
 
 /// The planner's word as the controller's PerceptionWatch hears it: a
-/// SOLVER_STATS "path clear" on a map of the latest scan (LIDAR_RAW), at
-/// 10 Hz, from `speaks_from` until `silent_after` seconds (a dead
-/// optimiser, or a mapper that gets no scans).
+/// SOLVER_STATS "path clear" on a map of now, at 10 Hz, from `speaks_from`
+/// until `silent_after` seconds (a dead optimiser, or a mapper that gets no
+/// scans).
 class PlannerStandIn {
  public:
   PlannerStandIn(sim::Lockstep& lockstep, double silent_after)
@@ -73,8 +71,6 @@ class PlannerStandIn {
     node_.subscribe<control_status_t>(channels::kControlStatus, [this](const control_status_t& m) {
       leg_ = {m.mission_id, m.active_waypoint};
     });
-    node_.subscribe<lidar_scan_t>(channels::kLidarRaw,
-                                  [this](const lidar_scan_t& m) { last_scan_ = m.utime; });
   }
   Node& node() { return node_; }
   double speaks_from = 0;
@@ -87,7 +83,7 @@ class PlannerStandIn {
     s.utime = now;
     s.status = solver_stats_t::NOT_RUN;
     s.message = "nominal guidance: path clear";
-    s.map_utime = last_scan_;
+    s.map_utime = now;
     s.guidance_clear = true;
     s.mission_id = leg_.first;
     s.active_waypoint = leg_.second;
@@ -96,7 +92,6 @@ class PlannerStandIn {
   Node node_;
   double silent_after_;
   std::pair<int, int> leg_{-1, -1};  // mission id, waypoint
-  Utime last_scan_ = 0;              // none yet: no map
 };
 
 FlightResult fly_open_course(const Scenario& scenario, bool scanner = true,
@@ -107,11 +102,8 @@ FlightResult fly_open_course(const Scenario& scenario, bool scanner = true,
   sim_config.lidar.enabled = scanner;
   vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), scenario, sim_config);
   uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), kOpenScenario);
-  // Without scans the planner has no map to confirm the leg on: a blind
-  // flight is flown without the planner's word.
-  auto controller_config = default_controller_config();
-  controller_config.perception.enabled = scanner;
-  control::ControllerService controller(lockstep.lcm(), lockstep.clock(), controller_config);
+  control::ControllerService controller(lockstep.lcm(), lockstep.clock(),
+                                        default_controller_config());
   lockstep.add(vehicle.node());
   lockstep.add(uplink.node());
   lockstep.add(controller.node());

@@ -7,6 +7,7 @@
 #include "ofn/common/message_names.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
+#include "ofn/common/validate/lidar_scan.hpp"
 #include "ofn/common/validate/mission.hpp"
 #include "ofn/common/validate/nav_state.hpp"
 #include "ofn/common/validate/ref_traj.hpp"
@@ -272,6 +273,10 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
   node_.subscribe<solver_stats_t>(
       channels::kSolverStats, [this](const solver_stats_t& m) { on_solver_stats(m); },
       SubscribeOptions{0.0, 0.5});
+  if (config_.sweep.enabled)
+    node_.subscribe<lidar_scan_t>(
+        channels::kLidarRaw, [this](const lidar_scan_t&) { on_lidar_scan(); },
+        SubscribeOptions{config_.sweep.scanner_timeout, 0.5});
   node_.add_timer(
       1.0 / config_.rate, [this] { control_step(); }, "control");
   node_.add_timer(
@@ -357,6 +362,10 @@ Limits ControllerService::flight_limits() const {
   return mission_ ? limits_from(mission_->limits) : gate_.airframe_limits();
 }
 
+void ControllerService::on_lidar_scan() {
+  last_scan_ = node_.now();
+}
+
 double ControllerService::yaw_reference(const std::optional<Vec3>& facing, double horizontal_speed,
                                         double dt, double* yaw_rate) {
   // Face along the path; sweep the scanner while it runs. The path
@@ -364,10 +373,9 @@ double ControllerService::yaw_reference(const std::optional<Vec3>& facing, doubl
   // turn leaves no lag.
   double yaw = path_heading_.update(facing, dt);
   *yaw_rate = path_heading_.turn_rate();
-  // The scanner counts as on while the planner's word names a fresh map
-  // (the 23 KB LIDAR_RAW stream is not needed here for that one bit).
+  const Utime now = node_.now();
   const bool scanner_on =
-      perception_.map_fresh(to_seconds(node_.now()), config_.sweep.scanner_timeout);
+      last_scan_ != INT64_MIN && now - last_scan_ <= to_utime(config_.sweep.scanner_timeout);
   if (!(config_.sweep.enabled && scanner_on && mode_ != control_status_t::HOLD)) {
     if (sweeping_) node_.log().info("yaw sweep stopped");
     sweeping_ = false;

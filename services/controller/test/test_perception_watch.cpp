@@ -31,21 +31,6 @@ TEST(PerceptionWatch, FreshStatusOnAFreshMapLetsGuidanceFly) {
   EXPECT_TRUE(watch.stale(10.81, kLeg));   // map past 1 s
 }
 
-TEST(PerceptionWatch, TheMapIsFreshWhileTheNewestStatusNamesARecentOne) {
-  PerceptionWatch watch;
-  EXPECT_FALSE(watch.map_fresh(10.0, 1.0));  // nothing heard
-  watch.on_status(10.0, 0.0, true, kLeg);    // a status without a map
-  EXPECT_FALSE(watch.map_fresh(10.0, 1.0));
-  watch.on_status(10.1, 9.9, false, kLeg);  // avoiding: the map still counts
-  EXPECT_TRUE(watch.map_fresh(10.1, 1.0));
-  EXPECT_TRUE(watch.map_fresh(10.9, 1.0));
-  EXPECT_FALSE(watch.map_fresh(10.91, 1.0));
-  EXPECT_TRUE(watch.map_fresh(11.4, 1.5));
-  // A status whose map no scan refreshed: no longer fresh.
-  watch.on_status(12.0, 9.9, true, kLeg);
-  EXPECT_FALSE(watch.map_fresh(12.0, 1.0));
-}
-
 TEST(PerceptionWatch, SilentPlannerOrOldMapHoldsGuidance) {
   PerceptionWatch watch;
   watch.on_status(10.0, 10.0, true, kLeg);

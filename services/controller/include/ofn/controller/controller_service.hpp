@@ -63,6 +63,7 @@ class ControllerService {
   // previous plan and braking override it (paper 2.1), if they start on the
   // reference flown now or on the vehicle.
   void on_ref_traj(ref_traj_t m);
+  void on_lidar_scan();
   /// The mission's limits; the airframe's before any mission.
   Limits flight_limits() const;
   void control_step();
@@ -88,6 +89,7 @@ class ControllerService {
   Utime last_flown_step_ = INT64_MIN;  // when last_ref_ was flown
   ControlOutput last_out_;
   Utime last_step_ = INT64_MIN;
+  Utime last_scan_ = INT64_MIN;
   YawSweepGenerator sweep_;
   bool sweeping_ = false;
 };

@@ -63,12 +63,6 @@ class PerceptionWatch {
   /// not begun (the controller goes on holding rather than stopping).
   bool confirmed_once() const { return confirmed_once_; }
 
-  /// Whether the newest status names a map no older than `max_age` at
-  /// `now`: the scans reach the planner (the yaw sweep runs only then).
-  bool map_fresh(double now, double max_age) const {
-    return std::isfinite(map_stamp_) && now - map_stamp_ <= max_age;
-  }
-
   /// The leg the newest status was given on (none before one).
   const MissionLeg& checked() const { return checked_; }
 
