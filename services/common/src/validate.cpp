@@ -254,7 +254,8 @@ std::string validate(const solver_stats_t& m) {
   if (!all_finite(v)) return "statistics not finite";
   if (m.active_waypoint < -1) return "active waypoint below -1";
   // The map a status was checked on is older than the status; a map stamp
-  // ahead of it would count as fresh for that long (guidance, the sweep).
+  // ahead of it would count as fresh for that long (the controller's
+  // PerceptionWatch lets guidance fly on a fresh map).
   // 1 s allows for the hosts' clocks, as a node's max_future does.
   constexpr int64_t kMapAheadOfStatus = 1000000;  // us
   if (m.map_utime > m.utime + kMapAheadOfStatus)
