@@ -3,14 +3,11 @@
 #include <nlopt.h>
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
-
-#include <Eigen/Dense>
 
 #include "ofn/common/bspline.hpp"
 #include "ofn/global_planner/global_planner.hpp"
