@@ -107,8 +107,14 @@ void WaypointGuidance::resync(const Vec3& position, const Vec3& velocity) {
   just_synced_ = true;
 }
 
+void WaypointGuidance::set_speed_reserve(double reserve) {
+  speed_reserve_ = std::isfinite(reserve) ? std::max(0.0, reserve) : 0.0;
+}
+
 double WaypointGuidance::leg_speed_limit() const {
   double v = cruise_speed_;
+  if (speed_reserve_ > 0 && limits_.max_speed > 0)
+    v = std::min(v, std::max(0.0, config_.speed_fraction * limits_.max_speed - speed_reserve_));
   // Keep the climb or descent rate within its own limit.
   const double vertical = std::abs(leg_dir_.z());
   if (vertical > 1e-9) v = std::min(v, limits_.max_vertical_speed / vertical);

@@ -158,6 +158,31 @@ TEST(WaypointGuidance, StraightLegRespectsSpeedAndAccelerationLimitsAndStopsAtTh
   EXPECT_GT(f.refs.size() * kDt, 100.0 / cruise);
 }
 
+TEST(WaypointGuidance, ASpeedReserveLowersTheCruiseWithoutASpeedStep) {
+  const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(300, 0, -30), 2.0}};
+  const GuidanceConfig config;
+  const double max_speed = 3.0, max_accel = 0.5;
+  PerfectFollower f(wps, max_speed, limits(max_speed, max_accel, 1.0), wps[0].position, config);
+  ASSERT_FALSE(f.run(30.0));  // at cruise, mid-leg
+  const double cruise = f.refs.back().velocity.norm();
+  EXPECT_NEAR(cruise, config.speed_fraction * max_speed, 1e-3);
+
+  f.guidance.set_speed_reserve(0.6);
+  const size_t from = f.refs.size();
+  ASSERT_FALSE(f.run(20.0));
+  for (size_t i = from; i < f.refs.size(); ++i) {
+    // It slows within its own acceleration limit: no step in speed.
+    EXPECT_LE(f.refs[i].acceleration.norm(), config.accel_fraction * max_accel + 1e-9);
+    EXPECT_LE(f.refs[i].velocity.norm(), cruise + 1e-9);
+  }
+  EXPECT_NEAR(f.refs.back().velocity.norm(), config.speed_fraction * max_speed - 0.6, 1e-3);
+
+  // Released, it speeds up to the cruise again; nonsense counts as none.
+  f.guidance.set_speed_reserve(std::nan(""));
+  ASSERT_FALSE(f.run(20.0));
+  EXPECT_NEAR(f.refs.back().velocity.norm(), cruise, 1e-3);
+}
+
 TEST(WaypointGuidance, StaysDoneAndStillAtTheLastWaypoint) {
   const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(20, 0, -30), 2.0}};
   PerfectFollower f(wps, 3.0, limits(3.0, 0.5, 1.0), wps[0].position);

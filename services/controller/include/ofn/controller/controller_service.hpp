@@ -14,6 +14,7 @@
 #include "ofn/controller/neural_adaptation.hpp"
 #include "ofn/controller/perception_watch.hpp"
 #include "ofn/controller/reference_selector.hpp"
+#include "ofn/controller/speed_reserve.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
 #include "ofn/lidar_scan_t.hpp"
@@ -36,6 +37,7 @@ struct ControllerConfig {
   ControllerGains gains;
   AdaptiveConfig adaptive;
   GuidanceConfig guidance;
+  SpeedReserveSettings speed_reserve;  // speed kept back from the limit in gusts
   YawSweep sweep;
   PathHeading heading;
   vehicle::RotorcraftParams nominal;  // the controller's model of the airframe
@@ -75,6 +77,8 @@ class ControllerService {
   ControllerConfig config_;
   TrajectoryController controller_;
   WaypointGuidance guidance_;
+  SpeedReserve speed_reserve_;
+  bool keeping_reserve_ = false;  // for the log: a reserve is kept back now
   ReferenceSelector selector_;
   PerceptionWatch perception_;
   CommandGate gate_;

@@ -153,7 +153,8 @@ class TrajectoryController {
   void set_speed_limits(double max_speed, double max_vertical_speed);
   /// Holds the adaptive element's weights (it still adds what it has
   /// learnt) while `hold` is true: for flight its inputs were never meant to
-  /// cover. The service holds them at a hover and in a look-around, where
+  /// cover. The service holds them at a hover in calm air and in a
+  /// look-around (not at a hover in gusts: SpeedReserve::gusty), where
   /// the heading (one of the networks' inputs) turns through full turns and
   /// sweeps +-60 deg while the vehicle barely moves: learning there, the
   /// inner network drove roll limit cycles of 0.4-0.5 rad after dead-end

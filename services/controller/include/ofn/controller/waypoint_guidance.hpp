@@ -79,6 +79,11 @@ class WaypointGuidance {
   /// vehicle, not one step ahead of it.
   GuidanceReference update(const Vec3& position, const Vec3& velocity, double dt);
 
+  /// m/s the cruise keeps back from its speed limit (SpeedReserve: room for
+  /// gusts); the reference slows towards the lower cruise within its
+  /// acceleration and jerk limits. Negative or non-finite counts as zero.
+  void set_speed_reserve(double reserve);
+
  private:
   void start_leg(const Vec3& from, int to_index, double speed_along);
   /// The piece the reference is on becomes the leg being rejoined again.
@@ -95,6 +100,7 @@ class WaypointGuidance {
   GuidanceConfig config_;
   std::vector<Waypoint> waypoints_;
   double cruise_speed_ = 0;
+  double speed_reserve_ = 0;  // m/s
   Limits limits_;
   int active_ = -1;
   int leg_cap_ = std::numeric_limits<int>::max();  // the planner's leg; no cap without one
