@@ -2,13 +2,17 @@
 """Monte Carlo over seeded random obstacle fields: success rate, clearance and time ratio.
 
 Usage: monte_carlo.py [--build DIR] [--runs N] [--seed-base S] [--jobs N] [--out DIR]
-                      [--dense | --trap] [--keep-failures] [--keep-all] [--quick]
+                      [--dense | --trap] [--wind KT] [--turbulence LEVEL]
+                      [--keep-failures] [--keep-all] [--quick]
 
 Field i is bench/random_field.py's field of seed S + i: a fair one (a route
 always exists) by default, a dense one with --dense (10-25 obstacles, may be
 sealed), a trap field with --trap (a dead end, a wall wider than the map or
 a narrow pocket, clutter, sometimes a pop-up; may be sealed); the rules of
-all three are in that file. Each field is flown in the
+all three are in that file. --wind and --turbulence give every field
+random_field.py's weather (a steady wind from a direction drawn from the
+seed, MIL-F-8785C turbulence; the baseline flies in calm air, so its time
+ratio is against a calm flight). Each field is flown in the
 lockstep runner, N at a time, and, when the build has ofn_baseline, given
 its time-optimal baseline. Writes OUT/report.md, OUT/results.json (every
 run), OUT/clearance.png, OUT/time_ratio.png, OUT/fields/field-SEED.yaml
@@ -106,7 +110,7 @@ def rerun_commands(args, seed):
     gen = os.path.join(HERE, "random_field.py")
     tpl = "" if os.path.realpath(args.template) == os.path.realpath(random_field.DEFAULT_TEMPLATE) \
         else " --template " + os.path.abspath(args.template)
-    kind = KIND_FLAGS[args.kind]
+    kind = KIND_FLAGS[args.kind] + weather_flags(args)
     name = field_name(args, seed)
     link = "".join(" --%s %g" % (flag, value) for flag, value in
                    (("link-loss", args.link_loss), ("link-delay", args.link_delay),
@@ -118,6 +122,20 @@ def rerun_commands(args, seed):
                               name, args.config_dir, " ".join([""] + runner_link_args(args, seed)),
                               name))
     return one, two
+
+
+def weather_flags(args):
+    """random_field.py's options for the fields' weather."""
+    return (" --wind %g" % args.wind if args.wind > 0 else "") + \
+        (" --turbulence %s" % args.turbulence if args.turbulence != "none" else "")
+
+
+def weather_text(args):
+    if args.wind <= 0 and args.turbulence == "none":
+        return "calm"
+    return ", ".join(([("%g kt of wind from a direction drawn from each field's seed" % args.wind)]
+                      if args.wind > 0 else [])
+                     + ([args.turbulence + " turbulence"] if args.turbulence != "none" else []))
 
 
 def link_faulty(args):
@@ -169,7 +187,8 @@ def judge_field(r):
 def fly_field(args, seed, template):
     """Generate, fly and (if possible) baseline one field; tidy its folder."""
     field = os.path.join(args.out, "fields", field_name(args, seed) + ".yaml")
-    obstacles = random_field.write_field(seed, field, template, args.kind)
+    obstacles = random_field.write_field(seed, field, template, args.kind, wind_kt=args.wind,
+                                         turbulence=args.turbulence)
     run_dir = os.path.join(args.out, "runs", "seed-%d" % seed)
     rec = campaign.run_lockstep(args.build, field, run_dir, args.config_dir,
                                 extra_args=runner_link_args(args, seed))
@@ -295,8 +314,9 @@ def write_report(args, runs, ctx):
         "- commit: %s" % ctx["commit"],
         "- binaries: %s/bin, configuration %s" % (args.build, args.config_dir),
         "- fields: seeds %s (bench/random_field.py%s, course from %s), %d flown %d at a time"
-        % (seeds_text(args.seeds), KIND_FLAGS[args.kind],
+        % (seeds_text(args.seeds), KIND_FLAGS[args.kind] + weather_flags(args),
            os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
+        "- weather: %s" % weather_text(args),
         "- link: %s" % ("between hosts (deploy/processes.yaml), %g %% of the datagrams lost, "
                          "every message %g +- %g s late, drawn from each field's seed"
                          % (100 * args.link_loss, args.link_delay, args.link_jitter)
@@ -318,7 +338,8 @@ def write_report(args, runs, ctx):
            "mode": args.kind, "runs": n, "outcomes": outcomes,
            "baselines_available": have_baseline, "wall_s": ctx["wall_s"], "load_average": ctx["load"],
            "seed_base": args.seed_base, "seeds": args.seeds, "link_loss": args.link_loss,
-           "link_delay": args.link_delay, "link_jitter": args.link_jitter}
+           "link_delay": args.link_delay, "link_jitter": args.link_jitter, "wind_kt": args.wind,
+           "turbulence": args.turbulence}
     clear_known = [c for c in clear if c is not None]
     if args.judged:
         routed = [r for r in runs if r["route"] is True]
@@ -495,6 +516,7 @@ def build_parser():
                     help="and delay every message between hosts by S seconds (default: 0)")
     ap.add_argument("--link-jitter", type=float, default=0.0, metavar="S",
                     help="give that delay a uniform +-S jitter (default: 0)")
+    random_field.add_weather_arguments(ap)
     return ap
 
 

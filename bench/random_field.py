@@ -2,7 +2,7 @@
 """Seeded random obstacle fields over the benchmark course, written as scenario YAML.
 
 Usage: random_field.py --seed S --out FILE [--dense | --trap] [--out-and-back]
-                       [--template sim/scenarios/bench1.yaml]
+                       [--wind KT] [--turbulence LEVEL] [--template sim/scenarios/bench1.yaml]
 
 The course (start, goal waypoint, limits, gates, max_time, units) is copied
 from the template, bench1 by default; only the obstacles are drawn. The same
@@ -12,6 +12,11 @@ waypoint (one more waypoint, with the goal's capture radius, and twice the
 time limit): the same obstacles, flown both ways over one line, so that
 the legs of a route of several legs are exercised. The gates still time
 the way out.
+With --wind KT a steady horizontal wind of KT knots blows from a direction
+drawn from the seed (its own random stream: the obstacles are those of the
+calm field of the same seed), and --turbulence LEVEL (light, moderate,
+severe: MIL-F-8785C, docs/SCENARIO_FORMAT.md) rides on it, seeded by the
+field's seed. The airframe is the configured one.
 
 Two classes of field (../shared/BENCHMARKS.md): "fair" fields (the default),
 in which a route with R_s clearance always exists, and "dense" fields
@@ -96,6 +101,7 @@ pop-up as well. Like dense fields they may be sealed (the baseline says).
   within 40 <= x <= 380 (the run-up and run-out stay clear); the wall may
   reach far beyond |y| = 160. max_time is 300 s (a wall's end may be far).
 """
+import argparse
 import copy
 import math
 import os
@@ -568,9 +574,33 @@ def out_and_back(tpl):
     return course
 
 
-def field_yaml(seed, obstacles, tpl, template_name, kind="fair", both_ways=False):
+# Feet or metres per second in one knot, by the template's units.
+KNOT = {"ft": 1.6878099, "m": 0.5144444}
+TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
+
+
+def weather_lines(seed, units, wind_kt=0.0, turbulence="none"):
+    """The environment and disturbances sections of a field's weather: a wind of `wind_kt`
+    knots from a direction drawn from the seed, and turbulence of that level."""
+    lines = []
+    if wind_kt > 0:
+        # A stream of its own: the same seed gives the same obstacles in calm and in wind.
+        towards = random.Random("wind-%d" % seed).uniform(0.0, 360.0)
+        speed = wind_kt * KNOT[units]
+        wx, wy = speed * math.cos(math.radians(towards)), speed * math.sin(math.radians(towards))
+        lines += ["environment:",
+                  "  wind: [%.2f, %.2f, 0]   # %g kt blowing towards %.0f deg from the course's x axis"
+                  % (wx, wy, wind_kt, towards)]
+    if turbulence != "none":
+        lines += ["disturbances:", "  turbulence: %s" % turbulence, "  seed: %d" % seed]
+    return lines
+
+
+def field_yaml(seed, obstacles, tpl, template_name, kind="fair", both_ways=False, wind_kt=0.0,
+               turbulence="none"):
     """Scenario text in the bench file layout; `kind` is fair, dense or trap; `both_ways`: the
-    course out and back (out_and_back)."""
+    course out and back (out_and_back); `wind_kt` and `turbulence`: its weather
+    (weather_lines)."""
     if both_ways:
         tpl = out_and_back(tpl)
     start, lim, gates = tpl["start"], tpl["limits"], tpl["gates"]
@@ -604,6 +634,19 @@ def field_yaml(seed, obstacles, tpl, template_name, kind="fair", both_ways=False
             "name: field-%d" % seed,
             "description: random field %d, %d obstacles (%d tall)" % (seed, len(obstacles), tall),
         ]
+    weather = weather_lines(seed, tpl["units"], wind_kt, turbulence)
+    if weather:
+        flags = (" --wind %g" % wind_kt if wind_kt > 0 else "") + \
+            (" --turbulence %s" % turbulence if turbulence != "none" else "")
+        for i, line in enumerate(head):
+            if line.startswith("# Regenerate:"):
+                head[i] = line.replace(" --out FILE", flags + " --out FILE")
+            elif line.startswith("name: "):
+                head[i] = line + "-wind" if wind_kt > 0 else line + "-turbulent"
+            elif line.startswith("description: "):
+                head[i] = line + ", %s" % ", ".join(
+                    ([("%g kt wind" % wind_kt)] if wind_kt > 0 else [])
+                    + ([turbulence + " turbulence"] if turbulence != "none" else []))
     if both_ways:
         for i, line in enumerate(head):
             if line.startswith("# Regenerate:"):
@@ -648,6 +691,7 @@ def field_yaml(seed, obstacles, tpl, template_name, kind="fair", both_ways=False
                                           else "   # low: may climb over"))
         if "appear_time" in ob:
             lines.append("    appear_time: %s   # s; seen before it can be reached" % _num(ob["appear_time"]))
+    lines += weather
     if kind == "trap":
         lines.append("max_time: %s" % _num(TRAP_MAX_TIME * (2 if both_ways else 1)))
     elif "max_time" in tpl:
@@ -658,11 +702,16 @@ def field_yaml(seed, obstacles, tpl, template_name, kind="fair", both_ways=False
 GENERATORS = {"fair": generate, "dense": generate_dense, "trap": generate_trap}
 
 
-def write_field(seed, path, template=DEFAULT_TEMPLATE, kind="fair", both_ways=False):
-    """Write the field of `seed` of `kind` (fair, dense or trap) to `path`; returns its obstacle list."""
+def write_field(seed, path, template=DEFAULT_TEMPLATE, kind="fair", both_ways=False, wind_kt=0.0,
+                turbulence="none"):
+    """Write the field of `seed` of `kind` (fair, dense or trap) to `path`, in the weather of
+    weather_lines; returns its obstacle list."""
     tpl = load_template(template)
+    if tpl["units"] not in KNOT:
+        raise ValueError("%s: units %r are neither ft nor m" % (template, tpl["units"]))
     obstacles, _ = GENERATORS[kind](seed, tpl)
-    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO), kind, both_ways)
+    text = field_yaml(seed, obstacles, tpl, os.path.relpath(template, REPO), kind, both_ways,
+                      wind_kt, turbulence)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w") as f:
         f.write(text)
@@ -683,6 +732,8 @@ def build_parser():
                "      --out /tmp/dense-7.yaml\n"
                "  bench/random_field.py --trap --seed 7 --out /tmp/trap-7.yaml\n"
                "  bench/random_field.py --dense --out-and-back --seed 7 --out /tmp/dense-7-back.yaml\n"
+               "  bench/random_field.py --dense --wind 15 --turbulence moderate --seed 7 \\\n"
+               "      --out /tmp/dense-7-wind.yaml\n"
                "\n"
                "Exit codes: 0 when the field is written; 2 for bad arguments, an unusable\n"
                "template, a file that cannot be written or PyYAML missing.")
@@ -702,7 +753,29 @@ def build_parser():
     ap.add_argument("--out-and-back", action="store_true",
                     help="the course goes on from the goal back to the first waypoint, with the "
                          "same obstacles and twice the time limit (default: out only)")
+    add_weather_arguments(ap)
     return ap
+
+
+def wind_knots(text):
+    """--wind's value: knots, 0 to 60."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected knots, a number, got %r" % text)
+    if not 0.0 <= value <= 60.0:
+        raise argparse.ArgumentTypeError("expected 0 to 60 kt, got %g" % value)
+    return value
+
+
+def add_weather_arguments(ap):
+    """--wind and --turbulence (shared with bench/monte_carlo.py)."""
+    ap.add_argument("--wind", type=wind_knots, default=0.0, metavar="KT",
+                    help="a steady wind of KT knots from a direction drawn from the seed "
+                         "(default: 0, calm)")
+    ap.add_argument("--turbulence", choices=TURBULENCE_LEVELS, default="none",
+                    help="MIL-F-8785C turbulence on the wind, seeded by the field's seed "
+                         "(default: none)")
 
 
 def field_kind(args):
@@ -714,7 +787,7 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     try:
         obstacles = write_field(args.seed, args.out, args.template, field_kind(args),
-                                args.out_and_back)
+                                args.out_and_back, args.wind, args.turbulence)
     except OSError as exc:
         print("%s: error: %s: %s" % (PROG, exc.filename or args.out, exc.strerror), file=sys.stderr)
         return cr.EXIT_USAGE

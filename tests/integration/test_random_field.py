@@ -133,6 +133,29 @@ class FieldRules(unittest.TestCase):
                 for key in ("start", "limits", "gates"):
                     self.assertEqual(back[key], out[key], kind)
 
+    def test_wind_and_turbulence_blow_over_the_same_field(self):
+        directions = set()
+        with tempfile.TemporaryDirectory() as tmp:
+            for seed in (3, 5, 9):
+                calm, windy = os.path.join(tmp, "calm.yaml"), os.path.join(tmp, "windy.yaml")
+                rf.write_field(seed, calm, kind="fair")
+                rf.write_field(seed, windy, kind="fair", wind_kt=15, turbulence="moderate")
+                with open(calm) as f:
+                    out = yaml.safe_load(f)
+                with open(windy) as f:
+                    blown = yaml.safe_load(f)
+                # The weather draws from a stream of its own: the same obstacles.
+                self.assertEqual(blown["obstacles"], out["obstacles"], seed)
+                self.assertNotIn("environment", out)
+                self.assertNotIn("disturbances", out)
+                wx, wy, wh = blown["environment"]["wind"]
+                self.assertAlmostEqual(math.hypot(wx, wy), 15 * 1.6878099, delta=0.02)  # ft/s
+                self.assertEqual(wh, 0)
+                directions.add(round(math.degrees(math.atan2(wy, wx))))
+                self.assertEqual(blown["disturbances"], {"turbulence": "moderate", "seed": seed})
+                self.assertEqual(blown["name"], out["name"] + "-wind")
+        self.assertEqual(len(directions), 3)  # the direction comes from the seed
+
     def test_a_trap_file_is_a_scenario_with_its_pop_up_and_time_limit(self):
         with tempfile.TemporaryDirectory() as tmp:
             seed = next(s for s in TRAP_SEEDS
