@@ -42,7 +42,9 @@ struct ServiceSpec {
 // publish (heartbeats aside).
 const std::vector<ServiceSpec>& service_specs() {
   static const std::vector<ServiceSpec> specs = {
-      {"sensor_interface", {channels::kNavState, channels::kLidarRaw}, {channels::kScanWorld}},
+      {"sensor_interface",
+       {channels::kNavState, channels::kLidarRaw},
+       {channels::kScanWorld, channels::kScannerStatus}},
       {"mapper",
        {channels::kScanWorld, channels::kNavState},
        {channels::kObstacleGrid, channels::kCuboids}},
@@ -389,8 +391,9 @@ class Session {
       ChannelState& state = channels_[channel];
       state.comparison.channel = channel;
       state.producer = services_.size();
-      const bool stamped_by_scan =
-          channel == channels::kScanWorld || channel == channels::kObstacleGrid;
+      const bool stamped_by_scan = channel == channels::kScanWorld ||
+                                   channel == channels::kScannerStatus ||
+                                   channel == channels::kObstacleGrid;
       state.pairing =
           follow_sim_clock_ && !stamped_by_scan ? PairingKey::kSequence : PairingKey::kUtime;
     }

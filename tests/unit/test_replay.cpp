@@ -132,7 +132,7 @@ TEST_F(LogReplay, LockstepFlightReplaysIdenticallyThroughMapperAndPlanners) {
   const ReplayResult result = replay_log(flight_, o);
   SCOPED_TRACE(format_comparison(result));
   EXPECT_TRUE(result.matches());
-  ASSERT_EQ(result.channels.size(), 7u);
+  ASSERT_EQ(result.channels.size(), 8u);  // SCAN_WORLD ... NARROW_PASSAGES, SCANNER_STATUS too
   for (const auto& c : result.channels) {
     EXPECT_EQ(c.identical, c.recorded) << c.channel;
     EXPECT_EQ(c.replayed, c.recorded) << c.channel;

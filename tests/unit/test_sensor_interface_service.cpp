@@ -65,6 +65,9 @@ class SensorInterfaceServiceTest : public ::testing::Test {
       : lcm_("memq://"), clock_(kStart), service_(lcm_, clock_, config), bus_("bus", lcm_, clock_) {
     bus_.subscribe<scan_world_t>(channels::kScanWorld,
                                  [this](const scan_world_t& m) { published_.push_back(m); });
+    bus_.subscribe<scanner_status_t>(channels::kScannerStatus, [this](const scanner_status_t& m) {
+      scanner_status_.push_back(m);
+    });
   }
 
   void deliver() {
@@ -117,6 +120,7 @@ class SensorInterfaceServiceTest : public ::testing::Test {
   SensorInterfaceService service_;
   Node bus_;
   std::vector<scan_world_t> published_;
+  std::vector<scanner_status_t> scanner_status_;
 };
 
 TEST_F(SensorInterfaceServiceTest, ScanWaitsForNavigationThenComesOutInTheWorldFrame) {
@@ -172,6 +176,31 @@ TEST_F(SensorInterfaceServiceTest, ScanWithoutNavigationIsDroppedAfterPoseWait) 
   publish_scan(sphere_scan(kStart + 415 * kMs, 2));
   ASSERT_EQ(published_.size(), 1u);
   EXPECT_EQ(published_[0].scan_index, 2);
+}
+
+// The controller sweeps the scanner only while scans arrive: each accepted
+// scan says so at once, before it waits for navigation, whatever becomes of
+// it; a scan refused (out of order, or invalid) does not.
+TEST_F(SensorInterfaceServiceTest, EveryAcceptedScanSaysTheScannerScans) {
+  lidar_scan_t scan = sphere_scan(kStart + 20 * kMs, 7);
+  scan.status[3] = lidar_scan_t::NO_RETURN;
+  scan.status[5] = lidar_scan_t::MAX_RANGE;
+  publish_scan(scan);  // no navigation yet: the scan waits, the status does not
+  ASSERT_EQ(scanner_status_.size(), 1u);
+  EXPECT_TRUE(published_.empty());
+  EXPECT_EQ(scanner_status_[0].utime, scan.utime);
+  EXPECT_EQ(scanner_status_[0].scan_index, 7);
+  EXPECT_EQ(scanner_status_[0].beams, 40);
+  EXPECT_EQ(scanner_status_[0].returns, 38);
+
+  publish_scan(sphere_scan(kStart + 10 * kMs, 8));  // older than the last: refused
+  lidar_scan_t bad = sphere_scan(kStart + 30 * kMs, 9);
+  bad.max_range = -1;  // invalid: refused
+  publish_scan(bad);
+  EXPECT_EQ(scanner_status_.size(), 1u);
+  publish_scan(sphere_scan(kStart + 40 * kMs, 10));
+  ASSERT_EQ(scanner_status_.size(), 2u);
+  EXPECT_EQ(scanner_status_[1].scan_index, 10);
 }
 
 TEST_F(SensorInterfaceServiceTest, ScanWithNoNavigationAtAllIsDroppedAfterPoseWait) {

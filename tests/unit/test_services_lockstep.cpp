@@ -26,6 +26,7 @@
 #include "ofn/control_status_t.hpp"
 #include "ofn/controller/controller_service.hpp"
 #include "ofn/mission_uplink/mission_uplink_service.hpp"
+#include "ofn/sensor_interface/sensor_interface_service.hpp"
 #include "ofn/sim/lockstep.hpp"
 #include "ofn/solver_stats_t.hpp"
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
@@ -105,9 +106,14 @@ FlightResult fly_open_course(
   auto sim_config = default_sim_config();
   sim_config.lidar.enabled = scanner;
   vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), scenario, sim_config);
+  // It tells the controller that the scanner scans (SCANNER_STATUS).
+  auto sensor_reader = YamlReader::empty("(defaults)");
+  sensing::SensorInterfaceService sensor(lockstep.lcm(), lockstep.clock(),
+                                         sensing::load_sensor_interface_config(sensor_reader));
   uplink::MissionUplinkService uplink(lockstep.lcm(), lockstep.clock(), mission_path);
   control::ControllerService controller(lockstep.lcm(), lockstep.clock(), controller_config);
   lockstep.add(vehicle.node());
+  lockstep.add(sensor.node());
   lockstep.add(uplink.node());
   lockstep.add(controller.node());
   PlannerStandIn planner(lockstep, planner_silent_after);

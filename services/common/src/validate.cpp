@@ -117,6 +117,12 @@ std::string validate(const lidar_scan_t& m) {
   return "";
 }
 
+std::string validate(const scanner_status_t& m) {
+  if (m.beams < 0 || m.beams > MessageLimits::kMaxBeams) return "beam count out of range";
+  if (m.returns < 0 || m.returns > m.beams) return "returns not between 0 and the beams";
+  return "";
+}
+
 std::string validate(const scan_world_t& m) {
   if (auto e = check_frame(m.frame); !e.empty()) return e;
   if (auto e = check_count(m.num_points, m.points.size(), MessageLimits::kMaxScanPoints, "points");

@@ -7,10 +7,10 @@
 #include "ofn/common/message_names.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
-#include "ofn/common/validate/lidar_scan.hpp"
 #include "ofn/common/validate/mission.hpp"
 #include "ofn/common/validate/nav_state.hpp"
 #include "ofn/common/validate/ref_traj.hpp"
+#include "ofn/common/validate/scanner_status.hpp"
 #include "ofn/common/validate/solver_stats.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/controller/reference_source.hpp"
@@ -283,9 +283,11 @@ ControllerService::ControllerService(lcm::LCM& lcm, const Clock& clock, Controll
   node_.subscribe<solver_stats_t>(
       channels::kSolverStats, [this](const solver_stats_t& m) { on_solver_stats(m); },
       SubscribeOptions{0.0, 0.5});
+  // That the scanner scans, from the sensor interface beside this process
+  // (not the 23 KB scans themselves): the yaw sweep runs only then.
   if (config_.sweep.enabled)
-    node_.subscribe<lidar_scan_t>(
-        channels::kLidarRaw, [this](const lidar_scan_t&) { on_lidar_scan(); },
+    node_.subscribe<scanner_status_t>(
+        channels::kScannerStatus, [this](const scanner_status_t&) { on_scanner_status(); },
         SubscribeOptions{config_.sweep.scanner_timeout, 0.5});
   node_.add_timer(
       1.0 / config_.rate, [this] { control_step(); }, "control");
@@ -372,7 +374,7 @@ Limits ControllerService::flight_limits() const {
   return mission_ ? limits_from(mission_->limits) : gate_.airframe_limits();
 }
 
-void ControllerService::on_lidar_scan() {
+void ControllerService::on_scanner_status() {
   last_scan_ = node_.now();
 }
 

@@ -138,6 +138,7 @@ void SensorInterfaceService::on_scan(const lidar_scan_t& msg) {
     return;
   }
   newest_scan_utime_ = msg.utime;
+  publish_scanner_status(msg);
 
   PendingScan pending;
   pending.scan = raw_scan_from_message(msg);
@@ -153,6 +154,16 @@ void SensorInterfaceService::on_scan(const lidar_scan_t& msg) {
   }
   queue_.push_back(std::move(pending));
   drain_queue();
+}
+
+void SensorInterfaceService::publish_scanner_status(const lidar_scan_t& msg) {
+  scanner_status_t status;
+  status.utime = msg.utime;
+  status.scan_index = msg.scan_index;
+  status.beams = static_cast<int32_t>(msg.status.size());
+  status.returns =
+      static_cast<int32_t>(std::count(msg.status.begin(), msg.status.end(), lidar_scan_t::OK));
+  node_.publish(channels::kScannerStatus, status);
 }
 
 void SensorInterfaceService::drain_queue() {

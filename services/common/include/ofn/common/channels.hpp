@@ -9,6 +9,7 @@ inline constexpr const char* kMission = "MISSION";
 inline constexpr const char* kVirtualObstacles = "VIRTUAL_OBSTACLES";
 inline constexpr const char* kLidarRaw = "LIDAR_RAW";
 inline constexpr const char* kScanWorld = "SCAN_WORLD";
+inline constexpr const char* kScannerStatus = "SCANNER_STATUS";
 inline constexpr const char* kObstacleGrid = "OBSTACLE_GRID";
 inline constexpr const char* kCuboids = "CUBOIDS";
 inline constexpr const char* kGlobalPath = "GLOBAL_PATH";

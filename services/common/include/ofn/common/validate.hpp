@@ -15,6 +15,7 @@
 #include "ofn/common/validate/obstacle_grid.hpp"
 #include "ofn/common/validate/ref_traj.hpp"
 #include "ofn/common/validate/scan_world.hpp"
+#include "ofn/common/validate/scanner_status.hpp"
 #include "ofn/common/validate/sim_clock.hpp"
 #include "ofn/common/validate/solver_stats.hpp"
 #include "ofn/common/validate/virtual_obstacles.hpp"

@@ -17,10 +17,10 @@
 #include "ofn/controller/speed_reserve.hpp"
 #include "ofn/controller/trajectory_controller.hpp"
 #include "ofn/controller/waypoint_guidance.hpp"
-#include "ofn/lidar_scan_t.hpp"
 #include "ofn/mission_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/ref_traj_t.hpp"
+#include "ofn/scanner_status_t.hpp"
 #include "ofn/solver_stats_t.hpp"
 
 namespace ofn::control {
@@ -65,7 +65,7 @@ class ControllerService {
   // previous plan and braking override it (paper 2.1), if they start on the
   // reference flown now or on the vehicle.
   void on_ref_traj(ref_traj_t m);
-  void on_lidar_scan();
+  void on_scanner_status();
   /// The mission's limits; the airframe's before any mission.
   Limits flight_limits() const;
   void control_step();

@@ -26,7 +26,7 @@ struct YawSweep {
   bool enabled = true;
   double frequency = 0.2;            // Hz
   double total_angle = deg2rad(40);  // rad, peak to peak, at cruise
-  double scanner_timeout = 1.0;      // s without LIDAR_RAW after which the scanner counts as off
+  double scanner_timeout = 1.0;      // s with no SCANNER_STATUS: the scanner counts as off
   /// rad, peak to peak, at the widest (hovering); total_angle: never widens.
   double wide_total_angle = deg2rad(120);
   double widen_rate = deg2rad(10);  // rad/s the half angle changes at most once faded in

@@ -11,6 +11,7 @@
 #include "ofn/lidar_scan_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/scan_world_t.hpp"
+#include "ofn/scanner_status_t.hpp"
 #include "ofn/sensor_interface/pose_buffer.hpp"
 #include "ofn/sensor_interface/scan_processor.hpp"
 
@@ -62,6 +63,9 @@ class SensorInterfaceService {
 
   void on_nav(const nav_state_t& msg);
   void on_scan(const lidar_scan_t& msg);
+  // SCANNER_STATUS: the scan was accepted, so the scanner scans (the
+  // controller sweeps it only then); published before it waits for poses.
+  void publish_scanner_status(const lidar_scan_t& msg);
   /// Processes queued scans in arrival order while navigation covers them;
   /// drops those that can never be covered or have waited too long.
   void drain_queue();
