@@ -350,6 +350,25 @@ TEST(Validate, LidarScanRejectsBadBeams) {
   EXPECT_EQ(validate(m), "");
 }
 
+TEST(Validate, ScannerStatusCountsMustBeABeamCountAndAShareOfIt) {
+  scanner_status_t m{};
+  m.utime = 1'000'000;
+  m.beams = 1364;
+  m.returns = 1364;
+  EXPECT_EQ(validate(m), "");
+  m.returns = 0;
+  EXPECT_EQ(validate(m), "");
+  m.returns = 1365;
+  EXPECT_NE(validate(m), "");
+  m.returns = -1;
+  EXPECT_NE(validate(m), "");
+  m.returns = 0;
+  m.beams = -1;
+  EXPECT_NE(validate(m), "");
+  m.beams = MessageLimits::kMaxBeams + 1;
+  EXPECT_NE(validate(m), "");
+}
+
 TEST(Validate, ModesAndStatusesOutsideTheirConstantsAreRejected) {
   ref_traj_t m = good_traj();
   m.mode = ref_traj_t::LOOK_AROUND;
