@@ -110,7 +110,6 @@ FlownVelocity fly(const ControllerConfig& config, const StopFlight& flight) {
     ref.yaw = path_heading.update(facing, dt);
     ref.yaw_rate = path_heading.turn_rate();
     const double horizontal = std::hypot(nav.velocity.x(), nav.velocity.y());
-    controller.hold_adaptation(horizontal < config.heading.min_speed);
     double sweep_rate = 0;
     ref.yaw = wrap_angle(ref.yaw + sweep.update_at_speed(horizontal, config.heading.min_speed,
                                                          SweepCoverage{kClearance, kBraking}, dt,

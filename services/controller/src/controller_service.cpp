@@ -598,16 +598,12 @@ void ControllerService::control_step() {
   if (mode_ != previous)
     node_.log().info("mode {} -> {} at t={:.2f} s", control_mode_name(previous),
                      control_mode_name(mode_), to_seconds(now));
-  const bool looking_around =
-      mode_ == control_status_t::TRAJECTORY && ref_traj_ && looks_around(*ref_traj_);
   const double horizontal_speed = std::hypot(x.velocity.x(), x.velocity.y());
-  // The networks learn in flight; at a hover and in a look-around the
-  // heading turning over a vehicle that barely moves is all they would see.
-  // Not at a hover in gusts: the air still flows past the airframe, and
-  // with the weights held there the vehicle lost control at the end of
-  // windy courses (speed_reserve.hpp, docs/TUNING.md).
-  const bool slow_in_calm = horizontal_speed < config_.heading.min_speed && !speed_reserve_.gusty();
-  controller_.hold_adaptation(looking_around || slow_in_calm);
+  // The adaptive weights are never held. Held at a hover and through a
+  // look-around (the heading turning over a vehicle that barely moves),
+  // they were learnt for another heading to the wind: after a look-around
+  // in 10 kt the cyclics swung from limit to limit and the vehicle flew
+  // into obstacles (docs/TUNING.md); in calm air holding changed nothing.
   ref.yaw = yaw_reference(facing, horizontal_speed, dt, &ref.yaw_rate);
   // Whatever chose it, the reference flown stays inside the envelope.
   bool clamped = false;

@@ -43,8 +43,6 @@ class SpeedReserve {
   double rms() const;
   /// m/s to keep back from a speed limit of `max_speed` (m/s; <= 0: none).
   double reserve(double max_speed) const;
-  /// Whether the velocity error is above what calm flight shows (`onset`).
-  bool gusty() const { return rms() > settings_.onset; }
   /// Forgets what it has measured.
   void reset() { mean_square_ = 0.0; }
   const SpeedReserveSettings& settings() const { return settings_; }

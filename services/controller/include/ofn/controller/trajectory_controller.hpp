@@ -152,14 +152,11 @@ class TrajectoryController {
   /// Zero turns a limit off (the default).
   void set_speed_limits(double max_speed, double max_vertical_speed);
   /// Holds the adaptive element's weights (it still adds what it has
-  /// learnt) while `hold` is true: for flight its inputs were never meant to
-  /// cover. The service holds them at a hover in calm air and in a
-  /// look-around (not at a hover in gusts: SpeedReserve::gusty), where
-  /// the heading (one of the networks' inputs) turns through full turns and
-  /// sweeps +-60 deg while the vehicle barely moves: learning there, the
-  /// inner network drove roll limit cycles of 0.4-0.5 rad after dead-end
-  /// recoveries (dense fields 15, 18 and 20; without adaptation all three
-  /// flew cleanly).
+  /// learnt) while `hold` is true. The service no longer holds them: held
+  /// at a hover and through a look-around they were learnt for another
+  /// heading to the wind, and in wind the vehicle lost control after a
+  /// look-around (docs/TUNING.md); the adaptive-control tests still use
+  /// it.
   void hold_adaptation(bool hold) { adaptation_held_ = hold; }
   bool adaptation_held() const { return adaptation_held_; }
   /// Level-attitude hover command, the safe output when inputs are bad.
