@@ -6,9 +6,10 @@
 // tenths (the windy test course: an RMS velocity error of 0.45-0.7 m/s,
 // the ground speed swinging 7-11.5 ft/s against a 10 ft/s limit). Flying
 // at the limit leaves no room for the next gust, so the governor and the
-// guidance cruise keep back about one RMS of the velocity tracking error
-// once it rises clearly above what calm flight shows; below `onset` they
-// keep back nothing, so calm flights are not slowed.
+// guidance cruise keep back 1.5 RMS of the velocity tracking error once it
+// rises clearly above what calm flight shows, but never so much that the
+// vehicle crawls in the wind (slow flight in strong wind lost control);
+// below `onset` they keep back nothing, so calm flights are not slowed.
 // Pure core: SI units, the caller's time steps.
 
 #include "ofn/common/frames.hpp"
