@@ -110,7 +110,7 @@ def rerun_commands(args, seed):
     gen = os.path.join(HERE, "random_field.py")
     tpl = "" if os.path.realpath(args.template) == os.path.realpath(random_field.DEFAULT_TEMPLATE) \
         else " --template " + os.path.abspath(args.template)
-    kind = KIND_FLAGS[args.kind] + weather_flags(args)
+    kind = KIND_FLAGS[args.kind] + random_field.weather_flags(args.wind, args.turbulence)
     name = field_name(args, seed)
     link = "".join(" --%s %g" % (flag, value) for flag, value in
                    (("link-loss", args.link_loss), ("link-delay", args.link_delay),
@@ -122,12 +122,6 @@ def rerun_commands(args, seed):
                               name, args.config_dir, " ".join([""] + runner_link_args(args, seed)),
                               name))
     return one, two
-
-
-def weather_flags(args):
-    """random_field.py's options for the fields' weather."""
-    return (" --wind %g" % args.wind if args.wind > 0 else "") + \
-        (" --turbulence %s" % args.turbulence if args.turbulence != "none" else "")
 
 
 def weather_text(args):
@@ -314,7 +308,8 @@ def write_report(args, runs, ctx):
         "- commit: %s" % ctx["commit"],
         "- binaries: %s/bin, configuration %s" % (args.build, args.config_dir),
         "- fields: seeds %s (bench/random_field.py%s, course from %s), %d flown %d at a time"
-        % (seeds_text(args.seeds), KIND_FLAGS[args.kind] + weather_flags(args),
+        % (seeds_text(args.seeds),
+           KIND_FLAGS[args.kind] + random_field.weather_flags(args.wind, args.turbulence),
            os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
         "- weather: %s" % weather_text(args),
         "- link: %s" % ("between hosts (deploy/processes.yaml), %g %% of the datagrams lost, "

@@ -579,6 +579,12 @@ KNOT = {"ft": 1.6878099, "m": 0.5144444}
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
 
 
+def weather_flags(wind_kt=0.0, turbulence="none"):
+    """This script's options that give a field that weather ("" in calm air)."""
+    return (" --wind %g" % wind_kt if wind_kt > 0 else "") + \
+        (" --turbulence %s" % turbulence if turbulence != "none" else "")
+
+
 def weather_lines(seed, units, wind_kt=0.0, turbulence="none"):
     """The environment and disturbances sections of a field's weather: a wind of `wind_kt`
     knots from a direction drawn from the seed, and turbulence of that level."""
@@ -636,8 +642,7 @@ def field_yaml(seed, obstacles, tpl, template_name, kind="fair", both_ways=False
         ]
     weather = weather_lines(seed, tpl["units"], wind_kt, turbulence)
     if weather:
-        flags = (" --wind %g" % wind_kt if wind_kt > 0 else "") + \
-            (" --turbulence %s" % turbulence if turbulence != "none" else "")
+        flags = weather_flags(wind_kt, turbulence)
         for i, line in enumerate(head):
             if line.startswith("# Regenerate:"):
                 head[i] = line.replace(" --out FILE", flags + " --out FILE")
