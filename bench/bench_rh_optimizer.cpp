@@ -24,6 +24,7 @@
 
 namespace {
 
+using ofn::BsplineTrajectory;
 using ofn::Vec3;
 using namespace ofn::rh;
 
