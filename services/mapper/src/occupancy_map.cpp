@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
 #include <octomap/OcTree.h>
 #include <octomap/octomap.h>
+
+#include "ofn/mapper/voxel_key_set.hpp"
 
 namespace ofn::mapping {
 
@@ -29,7 +32,24 @@ bool probability(double p) {
   return std::isfinite(p) && p > 0.0 && p < 1.0;
 }
 
+std::uint64_t pack(const octomap::OcTreeKey& key) {
+  return VoxelKeySet::pack(key[0], key[1], key[2]);
+}
+
+octomap::OcTreeKey unpack(std::uint64_t packed) {
+  return octomap::OcTreeKey(VoxelKeySet::x_of(packed), VoxelKeySet::y_of(packed),
+                            VoxelKeySet::z_of(packed));
+}
+
 }  // namespace
+
+// The key sets of one scan, kept so that their memory is reused.
+struct OccupancyMap::ScanKeys {
+  VoxelKeySet occupied;  // voxels holding a return
+  VoxelKeySet ends;      // voxels rays are cast to
+  VoxelKeySet free;      // voxels the rays cross
+  octomap::KeyRay ray;
+};
 
 OccupancyMap::OccupancyMap(const OccupancyMapConfig& config) : config_(config) {
   require(std::isfinite(config.resolution) && config.resolution > 0, "resolution", "must be > 0");
@@ -45,6 +65,7 @@ OccupancyMap::OccupancyMap(const OccupancyMapConfig& config) : config_(config) {
           "must be > 0");
   require(std::isfinite(config.ground_altitude), "ground_altitude", "must be finite");
   tree_ = std::make_unique<octomap::OcTree>(config.resolution);
+  scan_keys_ = std::make_unique<ScanKeys>();
   tree_->setProbHit(config.prob_hit);
   tree_->setProbMiss(config.prob_miss);
   tree_->setClampingThresMin(config.clamp_min);
@@ -58,21 +79,24 @@ void OccupancyMap::insert_scan(const Vec3& sensor_origin, const std::vector<Vec3
                                const std::vector<Vec3>& free_ray_ends) {
   if (!finite(sensor_origin)) return;
   octomap::OcTree& tree = *tree_;
+  ScanKeys& keys = *scan_keys_;
   const octomap::point3d origin = to_point(sensor_origin);
   const double max_range = config_.max_range;
 
   // Every voxel is updated at most once per scan, and a voxel that holds a
   // return in this scan is not also cleared by a neighbouring beam: dense
-  // scans would otherwise count one observation many times.
-  octomap::KeySet occupied;
-  octomap::KeySet free_ends;
+  // scans would otherwise count one observation many times. Since each
+  // voxel is updated once, the order of the updates does not change the
+  // tree.
+  keys.occupied.clear();
+  keys.ends.clear();
   const auto add_free_end = [&](const Vec3& end) {
     const Vec3 d = end - sensor_origin;
     const double range = d.norm();
     if (!(range > 0)) return;
     const Vec3 clipped = range > max_range ? Vec3(sensor_origin + d * (max_range / range)) : end;
     octomap::OcTreeKey key;
-    if (tree.coordToKeyChecked(to_point(clipped), key)) free_ends.insert(key);
+    if (tree.coordToKeyChecked(to_point(clipped), key)) keys.ends.insert(pack(key));
   };
   for (const Vec3& hit : hits) {
     if (!finite(hit)) continue;
@@ -81,25 +105,23 @@ void OccupancyMap::insert_scan(const Vec3& sensor_origin, const std::vector<Vec3
       continue;
     }
     octomap::OcTreeKey key;
-    if (tree.coordToKeyChecked(to_point(hit), key)) occupied.insert(key);
+    if (tree.coordToKeyChecked(to_point(hit), key)) keys.occupied.insert(pack(key));
   }
   for (const Vec3& end : free_ray_ends)
     if (finite(end)) add_free_end(end);
+  for (const std::uint64_t key : keys.occupied.keys()) keys.ends.insert(key);
 
   // Rays are cast to the centres of the end voxels (as OctoMap's discretised
   // insertion does), which collapses the many beams ending in one voxel.
-  octomap::KeySet free;
-  octomap::KeyRay ray;
-  const auto carve = [&](const octomap::OcTreeKey& end_key) {
-    if (!tree.computeRayKeys(origin, tree.keyToCoord(end_key), ray)) return;
-    free.insert(ray.begin(), ray.end());
-  };
-  for (const auto& key : occupied) carve(key);
-  for (const auto& key : free_ends) carve(key);
+  keys.free.clear();
+  for (const std::uint64_t end : keys.ends.keys()) {
+    if (!tree.computeRayKeys(origin, tree.keyToCoord(unpack(end)), keys.ray)) continue;
+    for (const octomap::OcTreeKey& key : keys.ray) keys.free.insert(pack(key));
+  }
 
-  for (const auto& key : free)
-    if (occupied.find(key) == occupied.end()) tree.updateNode(key, false);
-  for (const auto& key : occupied) tree.updateNode(key, true);
+  for (const std::uint64_t key : keys.free.keys())
+    if (!keys.occupied.contains(key)) tree.updateNode(unpack(key), false);
+  for (const std::uint64_t key : keys.occupied.keys()) tree.updateNode(unpack(key), true);
 }
 
 namespace {

@@ -67,8 +67,10 @@ class OccupancyMap {
   const octomap::OcTree& tree() const { return *tree_; }
 
  private:
+  struct ScanKeys;
   OccupancyMapConfig config_;
   std::unique_ptr<octomap::OcTree> tree_;
+  std::unique_ptr<ScanKeys> scan_keys_;
 };
 
 }  // namespace ofn::mapping
