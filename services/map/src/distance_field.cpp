@@ -114,6 +114,11 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
   require(span * static_cast<double>(cells) <= 1.0e8, "alt_hi",
           "gives more than 1e8 samples at this resolution");
 
+  const int slices = field.empty() ? 0 : std::max(0, static_cast<int>(span)) + 1;
+  // The same input as the last build (a hover re-maps the same cells): the
+  // slices already transformed stay, bit for bit what a rebuild would give.
+  if (same_input(field, alt_lo, slices, occupied_above)) return;
+
   geometry_.origin_north = field.origin_north;
   geometry_.origin_east = field.origin_east;
   geometry_.resolution = field.resolution;
@@ -121,15 +126,16 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
   geometry_.cols = field.cols;
   geometry_.top.clear();
   alt_lo_ = alt_lo;
+  occupied_above_ = occupied_above;
   reaching_exterior_valid_ = false;
   slices_built_ = 0;
+  slices_ = slices;
   if (field.empty()) {
-    slices_ = 0;
     distance_.clear();
     slice_built_.clear();
+    tops_.clear();
     return;
   }
-  slices_ = std::max(0, static_cast<int>(span)) + 1;
 
   const int longest = std::max(field.rows, field.cols);
   tops_.resize(cells);
@@ -158,6 +164,23 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
     for (int c = 0; c < field.cols; ++c)
       tops_transposed_[static_cast<size_t>(c) * field.rows + r] =
           tops_[static_cast<size_t>(r) * field.cols + c];
+}
+
+bool DistanceField::same_input(const Heightfield& field, double alt_lo, int slices,
+                               double occupied_above) const {
+  // Compared as the build would store them: the geometry bit for bit, each
+  // cell by whether it is an obstacle and its top.
+  if (slices_ == 0 || slices != slices_ || alt_lo != alt_lo_ || occupied_above != occupied_above_ ||
+      field.origin_north != geometry_.origin_north || field.origin_east != geometry_.origin_east ||
+      field.resolution != geometry_.resolution || field.rows != geometry_.rows ||
+      field.cols != geometry_.cols || field.top.size() != tops_.size())
+    return false;
+  for (size_t c = 0; c < tops_.size(); ++c) {
+    const float top = field.top[c];
+    const float stored = top > occupied_above ? top : -kInf;
+    if (stored != tops_[c]) return false;
+  }
+  return true;
 }
 
 void DistanceField::build_all_slices() const {

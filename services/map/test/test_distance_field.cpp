@@ -336,10 +336,56 @@ TEST(DistanceField, BuildsASliceOnlyWhenAQueryNeedsIt) {
   EXPECT_EQ(distance_field.slices_built(), 3);
   distance_field.distance(ned_of(25, 2, 20.2));  // both built already
   EXPECT_EQ(distance_field.slices_built(), 3);
-  distance_field.build(field, 0, 40);
+  Heightfield taller = field;
+  add_box(taller, 10, 10, 1, 1, 13.0f);
+  distance_field.build(taller, 0, 40);
   EXPECT_EQ(distance_field.slices_built(), 0);
   distance_field.build_all_slices();
   EXPECT_EQ(distance_field.slices_built(), 41);
+}
+
+TEST(DistanceField, ABuildOnTheSameInputKeepsItsSlices) {
+  Heightfield field = make_grid(30, 30, 1.0);
+  add_box(field, 10, 10, 4, 4, 12.0f);
+  field.top[0] = 0.25f;  // below occupied_above: free, as 0 is
+  DistanceField distance_field;
+  distance_field.build(field, 0, 40);
+  const Vec3 probe = ned_of(5, 5, 20.5);
+  const DistanceSample before = distance_field.query(probe);
+  ASSERT_EQ(distance_field.slices_built(), 2);
+
+  Heightfield same = field;
+  same.top[0] = 0.0f;  // another free value: the same field
+  distance_field.build(same, 0, 40);
+  EXPECT_EQ(distance_field.slices_built(), 2);
+  const DistanceSample after = distance_field.query(probe);
+  EXPECT_EQ(after.distance, before.distance);
+  EXPECT_EQ(after.gradient, before.gradient);
+  EXPECT_EQ(distance_field.slices_built(), 2);
+
+  // Any difference a transform would see starts afresh: a band, a
+  // threshold, the origin or one top.
+  const auto rebuilt = [&](const Heightfield& input, double alt_lo, double alt_hi,
+                           double occupied_above) {
+    distance_field.build(field, 0, 40);
+    distance_field.query(probe);
+    distance_field.build(input, alt_lo, alt_hi, occupied_above);
+    return distance_field.slices_built() == 0;
+  };
+  EXPECT_TRUE(rebuilt(field, 1, 40, 0.5));
+  EXPECT_TRUE(rebuilt(field, 0, 41, 0.5));
+  EXPECT_TRUE(rebuilt(field, 0, 40, 0.2));
+  Heightfield moved = field;
+  moved.origin_north += 0.5;
+  EXPECT_TRUE(rebuilt(moved, 0, 40, 0.5));
+  Heightfield raised = field;
+  raised.top[static_cast<size_t>(12 * 30 + 12)] = 12.5f;
+  EXPECT_TRUE(rebuilt(raised, 0, 40, 0.5));
+
+  // A rebuilt field answers as a fresh one does.
+  DistanceField fresh;
+  fresh.build(raised, 0, 40);
+  EXPECT_EQ(distance_field.query(probe).distance, fresh.query(probe).distance);
 }
 
 TEST(DistanceField, SlicesBuiltInAnyOrderEqualAnEagerBuild) {

@@ -48,7 +48,9 @@ class DistanceField {
   /// `occupied_above` count as obstacle columns. Each slice is transformed
   /// when a query first needs it. Throws std::invalid_argument on a
   /// non-positive resolution or max_distance, alt_hi < alt_lo, or a top
-  /// vector that does not match rows * cols.
+  /// vector that does not match rows * cols. A build on the same input as
+  /// the last one (same geometry, band and obstacle tops) keeps the slices
+  /// already transformed: they are what a fresh transform would give.
   void build(const Heightfield& field, double alt_lo, double alt_hi, double occupied_above = 0.5);
   /// Transforms every slice now (for a caller that wants the cost up front).
   void build_all_slices() const;
@@ -64,13 +66,15 @@ class DistanceField {
 
   const DistanceFieldConfig& config() const { return config_; }
   int slices() const { return slices_; }
-  /// Slices transformed since the last build().
+  /// Slices transformed since the last build() whose input changed.
   int slices_built() const { return slices_built_; }
   double altitude_low() const { return alt_lo_; }
 
  private:
   template <bool kWithGradient>
   double sample(const Vec3& ned, Vec3* gradient) const;
+  // True when build() would store exactly what it holds now.
+  bool same_input(const Heightfield& field, double alt_lo, int slices, double occupied_above) const;
   // Slice k, unless it is built already.
   void ensure_slice(int k) const;
   // One slice: the exterior transform into slice_out, then the interior
@@ -80,6 +84,7 @@ class DistanceField {
   DistanceFieldConfig config_;
   Heightfield geometry_;  // top left empty; only the grid geometry is kept
   double alt_lo_ = 0;
+  double occupied_above_ = 0;
   int slices_ = 0;
   std::vector<float> tops_;             // rows * cols; -inf where free
   std::vector<float> tops_transposed_;  // cols * rows
