@@ -46,6 +46,16 @@ std::vector<Vec3> query_points(int count) {
   return points;
 }
 
+// Where trajectories within a few metres of one altitude query the field.
+std::vector<Vec3> points_near_one_altitude() {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> horizontal(-75, 75), altitude(27, 33);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 1024; ++i)
+    points.emplace_back(horizontal(rng), horizontal(rng), -altitude(rng));
+  return points;
+}
+
 // Two fields one cell apart, built in turn: a build on the input of the
 // last one keeps its slices, so the same field twice would measure nothing.
 std::array<Heightfield, 2> alternating_fields() {
@@ -71,11 +81,7 @@ BENCHMARK(BM_DistanceFieldBuild)->Unit(benchmark::kMillisecond);
 // there are transformed.
 void BM_DistanceFieldBuildAndQueryNearOneAltitude(benchmark::State& state) {
   const std::array<Heightfield, 2> fields = alternating_fields();
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> horizontal(-75, 75), altitude(27, 33);
-  std::vector<Vec3> points;
-  for (int i = 0; i < 1024; ++i)
-    points.emplace_back(horizontal(rng), horizontal(rng), -altitude(rng));
+  const std::vector<Vec3> points = points_near_one_altitude();
   DistanceField distance_field;
   size_t n = 0;
   for (auto _ : state) {
@@ -89,11 +95,7 @@ BENCHMARK(BM_DistanceFieldBuildAndQueryNearOneAltitude)->Unit(benchmark::kMillis
 // hover over mapped ground): the slices transformed stay.
 void BM_DistanceFieldRebuildSameInputAndQuery(benchmark::State& state) {
   const Heightfield field = wall_and_boxes();
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> horizontal(-75, 75), altitude(27, 33);
-  std::vector<Vec3> points;
-  for (int i = 0; i < 1024; ++i)
-    points.emplace_back(horizontal(rng), horizontal(rng), -altitude(rng));
+  const std::vector<Vec3> points = points_near_one_altitude();
   DistanceField distance_field;
   for (auto _ : state) {
     distance_field.build(field, 0, 59);
