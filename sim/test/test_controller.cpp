@@ -471,6 +471,47 @@ TEST(TrajectoryController, HugePositionErrorStaysWithinLimits) {
   }
 }
 
+/// An adaptive element that has learnt a fixed outer-loop share: the model
+/// error of an updraft the nominal rotor does not know.
+class FixedOuterShare final : public AdaptiveElement {
+ public:
+  explicit FixedOuterShare(const Vec3& share) : share_(share) {}
+  Vec3 outer_output(const AdaptiveInputs&) override { return share_; }
+  Vec3 inner_output(const AdaptiveInputs&) override { return Vec3::Zero(); }
+  void update(const AdaptiveInputs&) override {}
+  void reset() override {}
+
+ private:
+  Vec3 share_;
+};
+
+TEST(TrajectoryController, TheAdaptiveShareIsNotCutByThePseudoControlBound) {
+  // A reference far below: the vertical pseudo-control is at its bound. An
+  // updraft the nominal model does not know (the adaptive element has
+  // learnt it as -2 m/s^2, i.e. the rotor lifts more than modelled) must
+  // still lower the thrust: bounded together, the bound took the share
+  // and the vehicle climbed away at full down command.
+  const RotorcraftParams p;
+  const ControllerGains g;
+  Reference ref;
+  ref.position = Vec3(0, 0, 200);  // 200 m below (NED)
+  auto first_step = [&](const Vec3& share) {
+    TrajectoryController controller(p, g, std::make_unique<FixedOuterShare>(share));
+    return controller.step(ref, VehicleEstimate{}, kControlDt);
+  };
+  const ControlOutput plain = first_step(Vec3::Zero());
+  const ControlOutput updraft = first_step(Vec3(0, 0, -2.0));
+  ASSERT_TRUE(plain.valid && updraft.valid);
+  // What is asked of the vehicle is the same, and within the bound.
+  EXPECT_NEAR(plain.commanded_accel.z(), g.max_vertical_accel, 1e-9);
+  EXPECT_NEAR(updraft.commanded_accel.z(), g.max_vertical_accel, 1e-9);
+  EXPECT_TRUE(plain.saturated && updraft.saturated);
+  // The thrust is the nominal rotor's for 3 + 2 m/s^2 down: m (g - 5).
+  EXPECT_NEAR(plain.thrust, p.mass * (kGravity - g.max_vertical_accel), 0.02 * p.mass * kGravity);
+  EXPECT_NEAR(updraft.thrust, p.mass * (kGravity - g.max_vertical_accel - 2.0),
+              0.02 * p.mass * kGravity);
+}
+
 TEST(TrajectoryController, HoverCommandIsLevelTrim) {
   const TrajectoryController controller{RotorcraftParams{}};
   const RotorcraftModel model;

@@ -132,6 +132,7 @@ struct TrajectoryController::StepSignals {
   AdaptiveInputs ad;                     // filled stage by stage, learnt from at the end
   Vec3 rm_accel;                         // outer reference model's acceleration, world
   Vec3 accel_wanted;                     // outer pseudo-control less the adaptive share
+  Vec3 accel_inverted;                   // governed, bounded command less the adaptive share
   Vec3 other_world;                      // fuselage drag and tail side force, world, N
   Mat3 r_des;                            // attitude command as a rotation matrix
   Vec3 rm_angular;                       // inner reference model's angular acceleration, body
@@ -212,13 +213,21 @@ void TrajectoryController::outer_loop(const Reference& ref, const VehicleEstimat
   ad.outer_error_norm = std::hypot(ad.position_error.norm(), ad.velocity_error.norm());
   out->adaptive_accel = adaptive_->outer_output(ad);
   s.accel_wanted = ad.pseudo_accel - out->adaptive_accel;
-  Vec3 accel = govern_speed(s.accel_wanted, x.velocity);
+  // The governor and the bounds shape the acceleration asked of the
+  // vehicle; the adaptive share is added after them. It stands for what the
+  // nominal model gets wrong (an updraft's extra rotor thrust, a wind the
+  // blow-back and drag do not know), not for acceleration flown: bounded
+  // with the rest, an updraft of 0.3 g took the whole 3 m/s^2 of descent
+  // authority and the vehicle climbed away at full down command
+  // (docs/TUNING.md, "The adaptive share outside the pseudo-control bound").
+  Vec3 accel = govern_speed(ad.pseudo_accel, x.velocity);
   const Vec3 horizontal = clamp_norm(Vec3(accel.x(), accel.y(), 0.0), g.max_horizontal_accel);
   const double vertical = std::clamp(accel.z(), -g.max_vertical_accel, g.max_vertical_accel);
   out->saturated = (horizontal - Vec3(accel.x(), accel.y(), 0.0)).norm() > 1e-9 ||
-                   vertical != accel.z() || (accel - s.accel_wanted).norm() > 1e-9;
+                   vertical != accel.z() || (accel - ad.pseudo_accel).norm() > 1e-9;
   accel = Vec3(horizontal.x(), horizontal.y(), vertical);
   out->commanded_accel = accel;
+  s.accel_inverted = accel - out->adaptive_accel;
 }
 
 void TrajectoryController::invert_for_thrust(double yaw, StepSignals& s, ControlOutput* out) const {
@@ -229,7 +238,7 @@ void TrajectoryController::invert_for_thrust(double yaw, StepSignals& s, Control
   const Vec3 drag_body =
       -0.5 * p.air_density * p.drag_area.cwiseProduct(air_body.cwiseAbs()).cwiseProduct(air_body);
   s.other_world = s.world_from_body * (drag_body + Vec3(0.0, tail_thrust_estimate_, 0.0));
-  Vec3 force = p.mass * (out->commanded_accel - Vec3(0, 0, kGravity)) - s.other_world;
+  Vec3 force = p.mass * (s.accel_inverted - Vec3(0, 0, kGravity)) - s.other_world;
   // Never ask for less than a fraction of hover thrust or a large tilt.
   if (force.z() > -0.3 * p.mass * kGravity) force.z() = -0.3 * p.mass * kGravity;
   const double max_horizontal = -force.z() * std::tan(gains_.max_tilt);

@@ -120,8 +120,8 @@ class NoAdaptation final : public AdaptiveElement {
 
 struct ControlOutput {
   vehicle::Controls controls;
-  Vec3 commanded_accel = Vec3::Zero();     // outer-loop pseudo-control, world NED
-  Vec3 adaptive_accel = Vec3::Zero();      // adaptive share of it
+  Vec3 commanded_accel = Vec3::Zero();     // outer pseudo-control, governed, bounded, NED
+  Vec3 adaptive_accel = Vec3::Zero();      // adaptive share, taken off it after the bound
   Vec3 adaptive_angular = Vec3::Zero();    // inner-loop adaptive share, rad/s^2
   Vec3 hedge_accel = Vec3::Zero();         // outer hedge: commanded - achievable, m/s^2
   Vec3 hedge_angular = Vec3::Zero();       // inner hedge, rad/s^2
