@@ -141,6 +141,34 @@ TEST_F(RhOptimizerServiceTest, ClearWayAheadLeavesNominalGuidanceAlone) {
   EXPECT_EQ(stats_.back().status, solver_stats_t::NOT_RUN);
 }
 
+TEST_F(RhOptimizerServiceTest, TheControllersTrackingErrorWidensTheClearance) {
+  send(channels::kMission, mission());
+  // A wall whose top lies 7.5 m under the leg: clear of R_s (6.1 m) plus
+  // the engage margin (0.5 m).
+  const double top = kAltitude - 7.5;
+  int i = 0;
+  auto steps_with_error = [&](int steps, double error) {
+    for (const int end = i + steps; i < end; ++i) {
+      control_status_t status{};
+      status.utime = bus_.now();
+      status.mode = control_status_t::WAYPOINT;
+      status.mission_id = mission().mission_id;
+      status.active_waypoint = 1;
+      status.position_error[1] = error;
+      status.ref_traj_fresh = false;
+      send(channels::kControlStatus, status);
+      step(Vec3(kSpeed * 0.1 * i, 0, -kAltitude), 30, top);
+    }
+  };
+  // Calm: a tenth of a metre off, nothing widens.
+  steps_with_error(5, 0.1);
+  ASSERT_FALSE(service_.engaged());
+  // Gusts: the controller reports the vehicle 2.5 m off its reference, so
+  // every clearance widens by 2.0 m (TrackingTube: less the 0.5 m onset).
+  steps_with_error(5, 2.5);
+  EXPECT_TRUE(service_.engaged());
+}
+
 TEST_F(RhOptimizerServiceTest, TheMissionsNarrowPassagesGoOutOnceASecond) {
   std::vector<narrow_passages_t> lists;
   listener_.subscribe<narrow_passages_t>(channels::kNarrowPassages,

@@ -213,6 +213,13 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   u.min_expected = sc.integer("min_expected", u.min_expected);
   if (u.min_expected < 1 || u.min_expected > 10000) sc.fail("min_expected", "expected 1..10000");
   sc.finish();
+  YamlReader tt = r.child("tracking_tube");
+  TrackingTubeSettings& tube = c.tracking_tube;
+  tube.enabled = tt.boolean("enabled", tube.enabled);
+  tube.window = tt.number_in("window", tube.window, 0.5, 120.0);
+  tube.onset = tt.number_in("onset", tube.onset, 0.0, 100.0);
+  tube.max_extra = tt.number_in("max_extra", tube.max_extra, 0.0, 100.0);
+  tt.finish();
   r.finish();
   return c;
 }
@@ -270,6 +277,7 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
       switch_(config_.avoidance),
       visibility_(1.0, config_.visibility_band),
       scan_supply_(config_.scan_supply),
+      tube_(config_.tracking_tube),
       field_(config_.field),
       recovery_(config_.recovery),
       passages_(config_.passages.max_passages) {
@@ -288,8 +296,7 @@ RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
       SubscribeOptions{config_.path_max_age, 0.5});
   // The controller's leg moves this one on (LegTracker::follow).
   node_.subscribe<control_status_t>(
-      channels::kControlStatus,
-      [this](const control_status_t& m) { legs_.follow(m.mission_id, m.active_waypoint); },
+      channels::kControlStatus, [this](const control_status_t& m) { on_control_status(m); },
       SubscribeOptions{config_.nav_max_age, 0.5});
   if (config_.occlusion_depth > 0)
     node_.subscribe<scan_world_t>(
@@ -362,6 +369,29 @@ void RhOptimizerService::on_global_path(const global_path_t& m) {
   }
   route_ = std::move(points);
   route_utime_ = m.utime;
+}
+
+void RhOptimizerService::on_control_status(const control_status_t& m) {
+  legs_.follow(m.mission_id, m.active_waypoint);
+  // Only while a reference is flown: holding before the mission or done
+  // after it, the error says nothing of gusts.
+  if (m.mode == control_status_t::WAYPOINT || m.mode == control_status_t::TRAJECTORY ||
+      m.mode == control_status_t::SAFE_STOP)
+    tube_.add(to_seconds(m.utime),
+              Vec3(m.position_error[0], m.position_error[1], m.position_error[2]));
+}
+
+double RhOptimizerService::tracking_widening(Utime now) {
+  const double widening = tube_.extra_clearance();
+  if (std::abs(widening - logged_widening_) >= 0.25 ||
+      (widening == 0.0) != (logged_widening_ == 0.0)) {
+    node_.log().info(
+        "t={:.2f} s tracking tube: clearances widened by {:.2f} m (largest position error {:.2f} m "
+        "over the last {:.0f} s)",
+        to_seconds(now), widening, tube_.largest_error(), config_.tracking_tube.window);
+    logged_widening_ = widening;
+  }
+  return widening;
 }
 
 void RhOptimizerService::on_scan(const scan_world_t& m) {
@@ -627,7 +657,8 @@ void RhOptimizerService::tick() {
   }
   refresh_field(now, position);
 
-  const Limits limits = limits_from(mission_->limits);
+  Limits limits = limits_from(mission_->limits);
+  limits.clearance += tracking_widening(now);
   const Leg leg{active->from, active->to};
   const ClearanceQuery clearance = [this](const Vec3& p) { return field_.query(p); };
   const double required = limits.clearance + config_.avoidance.engage_margin;

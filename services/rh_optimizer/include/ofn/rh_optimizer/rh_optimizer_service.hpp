@@ -30,6 +30,7 @@
 #include "ofn/rh_optimizer/occlusion.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 #include "ofn/rh_optimizer/scan_supply.hpp"
+#include "ofn/rh_optimizer/tracking_tube.hpp"
 #include "ofn/scan_world_t.hpp"
 #include "ofn/solver_stats_t.hpp"
 
@@ -87,9 +88,10 @@ struct RhOptimizerServiceConfig {
   FallbackSettings fallback;
   CommitSettings commit;  // the safety invariant of every published plan
   SwitchSettings avoidance;
-  RecoverySettings recovery;       // out of dead ends
-  PassageSettings passages;        // routes through gaps too narrow to fly, told to the planner
-  ScanSupplySettings scan_supply;  // no plans on a map starved of scans
+  RecoverySettings recovery;           // out of dead ends
+  PassageSettings passages;            // routes through gaps too narrow to fly, told to the planner
+  ScanSupplySettings scan_supply;      // no plans on a map starved of scans
+  TrackingTubeSettings tracking_tube;  // clearances widened by the tracking error
 };
 
 /// Reads an rh_optimizer config; unknown fields are errors.
@@ -127,6 +129,12 @@ class RhOptimizerService {
   void on_grid(const obstacle_grid_t& m);
   void on_global_path(const global_path_t& m);
   void on_scan(const scan_world_t& m);
+  /// The controller's active leg (LegTracker::follow) and its position
+  /// error (the tracking tube).
+  void on_control_status(const control_status_t& m);
+  /// m the safety radius is widened by now (TrackingTube), logged when it
+  /// changes by a quarter metre or more.
+  double tracking_widening(Utime now);
   void tick();
   bool refresh_field(Utime now, const Vec3& vehicle);
   void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
@@ -167,6 +175,8 @@ class RhOptimizerService {
   int64_t scans_seen_ = 0;
   ScanSupply scan_supply_;
   bool scans_starved_ = false;
+  TrackingTube tube_;
+  double logged_widening_ = 0;  // m, the tube's widening last logged
   mapping::Heightfield heightfield_;
   // heightfield_ before the shadows: what the unseen extension starts from
   mapping::Heightfield mapped_;
