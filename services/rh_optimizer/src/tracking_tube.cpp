@@ -7,7 +7,14 @@ namespace ofn::rh {
 
 void TrackingTube::add(double time, const Vec3& position_error) {
   if (!std::isfinite(time) || !position_error.allFinite()) return;
-  if (!samples_.empty() && time < samples_.back().first) samples_.clear();
+  if (!samples_.empty() && time < samples_.back().first) {
+    // Reordered on the link: counted now, so that it still widens the tube
+    // (kept longer rather than lost). Far behind: a restarted clock.
+    if (samples_.back().first - time > settings_.window)
+      samples_.clear();
+    else
+      time = samples_.back().first;
+  }
   const double error = position_error.norm();
   while (!samples_.empty() && samples_.back().second <= error) samples_.pop_back();
   samples_.emplace_back(time, error);

@@ -32,8 +32,10 @@ class TrackingTube {
   explicit TrackingTube(TrackingTubeSettings settings = {}) : settings_(settings) {}
 
   /// One CONTROL_STATUS position error (reference - vehicle, m) stamped
-  /// `time` (s). Non-finite errors or times are ignored; a time before the
-  /// last one starts a new record (a restarted clock).
+  /// `time` (s). Non-finite errors or times are ignored. A time before the
+  /// newest one counts as the newest (a message reordered on the link);
+  /// one more than a window before it starts a new record (a restarted
+  /// clock).
   void add(double time, const Vec3& position_error);
   /// m, the largest error over the window ending at the newest sample (0
   /// with none): a controller that falls silent leaves the last tube in
