@@ -16,6 +16,7 @@ import base64
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -48,6 +49,10 @@ class Browser:
             # The descriptors are put in place after the fork; fds 3 and 4
             # must then stay open, which close_fds would undo.
             close_fds=False, preexec_fn=child_fds,
+            # Its own process group, so that close() ends the renderers and
+            # helpers too: left running, they wrote into the scratch folder
+            # after it was removed and it stayed in /tmp.
+            start_new_session=True,
             env=dict(os.environ, TMPDIR=self._scratch),
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         os.close(to_browser_r)
@@ -81,9 +86,17 @@ class Browser:
         return json.loads(message)
 
     def close(self):
-        self.process.kill()
+        try:
+            os.killpg(self.process.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
         self.process.wait()
-        shutil.rmtree(self._scratch, ignore_errors=True)
+        # A helper of the group may still be exiting: try a few times.
+        for _ in range(20):
+            shutil.rmtree(self._scratch, ignore_errors=True)
+            if not os.path.exists(self._scratch):
+                break
+            time.sleep(0.1)
 
 
 def main():
