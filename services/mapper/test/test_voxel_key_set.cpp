@@ -60,5 +60,23 @@ TEST(VoxelKeySet, HoldsWhatAnOrderedSetHoldsThroughGrowthAndClears) {
   }
 }
 
+TEST(VoxelKeySet, ASlotBySlotClearFindsKeysPastCollisions) {
+  // Enough keys that many probe past others, yet few enough (under an
+  // eighth of the table) that the clear goes slot by slot: each key must
+  // still be found where its probe sequence put it.
+  VoxelKeySet set;
+  for (std::uint16_t x = 0; x < 200; ++x)
+    for (std::uint16_t y = 0; y < 200; ++y) set.insert(VoxelKeySet::pack(x, y, 0));
+  set.clear();  // the table keeps its size: 131072 slots
+  std::vector<std::uint64_t> keys;
+  for (std::uint16_t x = 0; x < 125; ++x)
+    for (std::uint16_t y = 0; y < 128; ++y) keys.push_back(VoxelKeySet::pack(x, y, 1));
+  for (const std::uint64_t key : keys) ASSERT_TRUE(set.insert(key));
+  set.clear();
+  for (const std::uint64_t key : keys) ASSERT_FALSE(set.contains(key));
+  for (const std::uint64_t key : keys) ASSERT_TRUE(set.insert(key));
+  EXPECT_EQ(set.size(), keys.size());
+}
+
 }  // namespace
 }  // namespace ofn::mapping

@@ -26,31 +26,20 @@ class VoxelKeySet {
   /// True when the key was not in the set yet.
   bool insert(std::uint64_t key) {
     if (2 * (keys_.size() + 1) > slots_.size()) grow();
-    std::size_t i = slot_of(key);
-    while (slots_[i] != kEmpty) {
-      if (slots_[i] == key) return false;
-      i = (i + 1) & mask_;
-    }
+    const std::size_t i = probe(key);
+    if (slots_[i] == key) return false;
     slots_[i] = key;
     keys_.push_back(key);
     return true;
   }
-  bool contains(std::uint64_t key) const {
-    if (slots_.empty()) return false;
-    for (std::size_t i = slot_of(key); slots_[i] != kEmpty; i = (i + 1) & mask_)
-      if (slots_[i] == key) return true;
-    return false;
-  }
+  bool contains(std::uint64_t key) const { return !slots_.empty() && slots_[probe(key)] == key; }
   /// Empties the set and keeps its memory.
   void clear() {
     if (keys_.size() * 8 < slots_.size()) {
-      // Few keys in a large table: clear their slots only, following each
-      // key's probe sequence to where it lies.
-      for (const std::uint64_t key : keys_) {
-        std::size_t i = slot_of(key);
-        while (slots_[i] != key) i = (i + 1) & mask_;
-        slots_[i] = kEmpty;
-      }
+      // Few keys in a large table: clear their slots only, newest first.
+      // The slots a key's probe passes over were taken by keys inserted
+      // before it, so they are all still there when it is looked up.
+      for (auto key = keys_.rbegin(); key != keys_.rend(); ++key) slots_[probe(*key)] = kEmpty;
     } else {
       std::fill(slots_.begin(), slots_.end(), kEmpty);
     }
@@ -65,6 +54,13 @@ class VoxelKeySet {
   // A packed key uses 48 bits: all ones never occurs.
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
 
+  // The slot holding `key`, or else the empty slot that ends its probe
+  // sequence (linear probing).
+  std::size_t probe(std::uint64_t key) const {
+    std::size_t i = slot_of(key);
+    while (slots_[i] != kEmpty && slots_[i] != key) i = (i + 1) & mask_;
+    return i;
+  }
   std::size_t slot_of(std::uint64_t key) const {
     // Fibonacci hashing: neighbouring voxels spread over the table.
     return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift_);
@@ -76,11 +72,7 @@ class VoxelKeySet {
     shift_ = 64 - bits;
     mask_ = (std::size_t{1} << bits) - 1;
     slots_.assign(std::size_t{1} << bits, kEmpty);
-    for (const std::uint64_t key : keys_) {
-      std::size_t i = slot_of(key);
-      while (slots_[i] != kEmpty) i = (i + 1) & mask_;
-      slots_[i] = key;
-    }
+    for (const std::uint64_t key : keys_) slots_[probe(key)] = key;
   }
 
   std::vector<std::uint64_t> slots_;
