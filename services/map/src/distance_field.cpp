@@ -13,6 +13,12 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// A cell's top as the field keeps it: free cells are -inf (no exterior
+// site, and air at every altitude).
+float stored_top(float top, double occupied_above) {
+  return top > occupied_above ? top : -kInf;
+}
+
 void require(bool ok, const char* field, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("distance field: ") + field + " " + what);
 }
@@ -152,13 +158,10 @@ void DistanceField::build(const Heightfield& field, double alt_lo, double alt_hi
   distance_.resize(cells * static_cast<size_t>(slices_));
   slice_built_.assign(static_cast<size_t>(slices_), 0);
 
-  // Free cells are -inf: no exterior site, and air at every altitude.
   min_occupied_top_ = kInf;
   for (size_t c = 0; c < cells; ++c) {
-    const float top = field.top[c];
-    const bool occupied = top > occupied_above;
-    tops_[c] = occupied ? top : -kInf;
-    if (occupied) min_occupied_top_ = std::min(min_occupied_top_, top);
+    tops_[c] = stored_top(field.top[c], occupied_above);
+    if (tops_[c] > -kInf) min_occupied_top_ = std::min(min_occupied_top_, tops_[c]);
   }
   for (int r = 0; r < field.rows; ++r)
     for (int c = 0; c < field.cols; ++c)
@@ -175,11 +178,8 @@ bool DistanceField::same_input(const Heightfield& field, double alt_lo, int slic
       field.resolution != geometry_.resolution || field.rows != geometry_.rows ||
       field.cols != geometry_.cols || field.top.size() != tops_.size())
     return false;
-  for (size_t c = 0; c < tops_.size(); ++c) {
-    const float top = field.top[c];
-    const float stored = top > occupied_above ? top : -kInf;
-    if (stored != tops_[c]) return false;
-  }
+  for (size_t c = 0; c < tops_.size(); ++c)
+    if (stored_top(field.top[c], occupied_above) != tops_[c]) return false;
   return true;
 }
 
