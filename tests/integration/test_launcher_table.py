@@ -671,7 +671,11 @@ class SupervisionTest(LauncherTestCase):
         sleeper_cpu = [float(r["cpu_s"]) for r in by_service["sleeper"]]
         self.assertLess(sleeper_cpu[-1] - sleeper_cpu[0], 0.1, sleeper_cpu)
         self.assertRegex(result.stdout, r"grower .*; rss \d+\.\d MB \(peak \d+\.\d\), cpu \d+ %")
-        self.assertRegex(result.stdout, r"sleeper .*; rss \d+\.\d MB \(peak \d+\.\d\), cpu 0 %")
+        # The sleeper's first sample may fall before its exec is done, so the
+        # start-up of a loaded machine can show as a per cent or two.
+        idle = re.search(r"sleeper .*; rss \d+\.\d MB \(peak \d+\.\d\), cpu (\d+) %", result.stdout)
+        self.assertIsNotNone(idle, result.stdout)
+        self.assertLessEqual(int(idle.group(1)), 3, result.stdout)
         self.assertIn("resources.csv", result.stdout)
 
     def test_proc_resources_of_a_process_that_is_gone(self):
