@@ -202,6 +202,9 @@ def fly_field(args, seed, template):
         "min_clearance_over_rs": s["min_clearance"] / rs if rs and s.get("min_clearance") is not None else None,
         "min_clearance": s["min_clearance"] * k if s.get("min_clearance") is not None else None,
         "max_speed": s["max_speed"] * k if s.get("max_speed") is not None else None,
+        # Share of the controller's commands with a cyclic at its stop: the
+        # authority the weather used up (none from a runner without it).
+        "cyclic_at_stop": (s.get("controls_at_stop") or {}).get("cyclic"),
         "display_unit": unit,
         "baseline_status": base["status"], "baseline_time_s": base.get("baseline_time"),
         "wall_s": rec["wall_s"], "dir": run_dir,
@@ -390,6 +393,13 @@ def write_report(args, runs, ctx):
         ]
         doc.update(successes=ok, success_rate=rate, wilson95=[lo, hi], goal=SUCCESS_GOAL,
                    goal_met=rate >= SUCCESS_GOAL)
+    at_stop = [(r["cyclic_at_stop"], r["seed"]) for r in runs if r.get("cyclic_at_stop") is not None]
+    if at_stop:
+        worst = max(at_stop)
+        lines.append("| cyclic at its stop (share of the controller's commands) | median %.1f %%, most "
+                     "%.1f %% (seed %d) |" % (100 * median([v for v, _ in at_stop]), 100 * worst[0],
+                                              worst[1]))
+        doc.update(cyclic_at_stop_median=median([v for v, _ in at_stop]), cyclic_at_stop_max=worst[0])
     if ratio_note:
         lines += ["", ratio_note]
     lines += ["", "![least clearance](clearance.png)", "", "![time ratio](time_ratio.png)", "",

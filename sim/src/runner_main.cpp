@@ -201,7 +201,10 @@ int main(int argc, char** argv) {
       lockstep.record("/dev/null");
       const ofn::report::PseudoControlBound bound{controller_config.gains.max_horizontal_accel,
                                                   controller_config.gains.max_vertical_accel};
-      const auto result = ofn::report::write_flight_report(log_path, out_dir, scenario, bound);
+      const auto result = ofn::report::write_flight_report(
+          log_path, out_dir, scenario, bound, "",
+          ofn::report::ControlStops{controller_config.nominal.min_controls.as_array(),
+                                    controller_config.nominal.max_controls.as_array()});
       std::cout << result.text;
       // A safe stop does not arrive, yet is a proper end of the flight.
       return result.verdict.outcome == ofn::report::Outcome::kFailure ? 1 : 0;

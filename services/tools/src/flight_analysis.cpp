@@ -125,6 +125,31 @@ const char* to_string(Outcome outcome) {
   return "failure";
 }
 
+ControlSaturation control_saturation(const std::vector<std::array<double, 4>>& commands,
+                                     const ControlStops& stops) {
+  ControlSaturation out;
+  out.samples = commands.size();
+  if (commands.empty()) return out;
+  std::array<size_t, 4> at_stop{};
+  size_t cyclic = 0, any = 0;
+  for (const auto& command : commands) {
+    std::array<bool, 4> at{};
+    for (size_t i = 0; i < 4; ++i) {
+      const double band = kStopBand * (stops.max[i] - stops.min[i]);
+      at[i] = std::isfinite(command[i]) &&
+              (command[i] <= stops.min[i] + band || command[i] >= stops.max[i] - band);
+      at_stop[i] += at[i];
+    }
+    cyclic += at[1] || at[2];
+    any += at[0] || at[1] || at[2] || at[3];
+  }
+  const double n = static_cast<double>(commands.size());
+  for (size_t i = 0; i < 4; ++i) out.share[i] = static_cast<double>(at_stop[i]) / n;
+  out.cyclic_share = static_cast<double>(cyclic) / n;
+  out.any_share = static_cast<double>(any) / n;
+  return out;
+}
+
 Verdict judge_flight(const FlightSummary& s, const Limits& limits,
                      const PseudoControlBound& pseudo_control_bound,
                      std::optional<double> min_clearance, bool has_finish_gate,

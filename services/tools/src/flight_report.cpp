@@ -104,6 +104,8 @@ struct FlightRecord {
   std::vector<double> solve_times;
   std::map<int, int> solver_status_count;
   std::vector<TimeSpan> recovery;
+  // ACTUATOR_CMD in the channel order of ControlStops.
+  std::vector<std::array<double, 4>> commands;
   // Scan-to-plan latency: every map's stamp, and every step that planned.
   std::vector<double> map_stamps;
   std::vector<PlanStep> plan_steps;
@@ -245,7 +247,10 @@ class LogDecoder {
     if (channel == channels::kControlStatus)
       return on<control_status_t>(e, [this](auto& m) { control_status(m); });
     if (channel == channels::kActuatorCmd)
-      return on<actuator_cmd_t>(e, [this](auto& m) { tables_.command(rel(m.utime), m); });
+      return on<actuator_cmd_t>(e, [this](auto& m) {
+        tables_.command(rel(m.utime), m);
+        record_.commands.push_back({m.collective, m.lon_cyclic, m.lat_cyclic, m.pedal});
+      });
     if (channel == channels::kScanWorld)
       return on<scan_world_t>(
           e, [this](auto& m) { tables_.scan(rel(m.utime), m, &record_.scan_points_seen); });
@@ -444,6 +449,7 @@ struct Judged {
   Limits limits;
   std::optional<double> start_gate, finish_gate;
   PseudoControlBound pseudo_control_bound;
+  std::optional<ControlSaturation> saturation;  // none without the controller's stops
   std::optional<Clearance> clearance;
   std::vector<double> scan_to_plan;
   DisplayUnit unit;
@@ -486,6 +492,14 @@ nlohmann::ordered_json summary_json(const FlightRecord& record, const Judged& j,
   json["max_pseudo_control_vertical"] = s.max_pseudo_control_vertical;
   json["pseudo_control_bound"] = {{"horizontal", j.pseudo_control_bound.horizontal},
                                   {"vertical", j.pseudo_control_bound.vertical}};
+  if (j.saturation)
+    json["controls_at_stop"] = {
+        {"samples", j.saturation->samples},     {"collective", j.saturation->share[0]},
+        {"lon_cyclic", j.saturation->share[1]}, {"lat_cyclic", j.saturation->share[2]},
+        {"pedal", j.saturation->share[3]},      {"cyclic", j.saturation->cyclic_share},
+        {"any", j.saturation->any_share}};
+  else
+    json["controls_at_stop"] = nullptr;
   json["max_ref_position_jump"] = s.max_ref_position_jump;
   json["max_ref_position_jump_t"] = json_number(s.max_ref_position_jump_t);
   json["max_ref_velocity_jump"] = s.max_ref_velocity_jump;
@@ -575,6 +589,13 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
     << s.max_pseudo_control_horizontal / k << ", vertical " << s.max_pseudo_control_vertical / k
     << " (bounds " << j.pseudo_control_bound.horizontal / k << ", "
     << j.pseudo_control_bound.vertical / k << ")\n";
+  if (j.saturation && j.saturation->samples > 0) {
+    const ControlSaturation& c = *j.saturation;
+    t << "  controls at a stop: " << std::setprecision(1) << 100.0 * c.cyclic_share
+      << " % of the commands with a cyclic at its stop (longitudinal " << 100.0 * c.share[1]
+      << ", lateral " << 100.0 * c.share[2] << "; collective " << 100.0 * c.share[0] << ", pedal "
+      << 100.0 * c.share[3] << ")" << std::setprecision(2) << "\n";
+  }
   t << "  reference jump    : " << s.max_ref_position_jump / k << " " << unit << ", "
     << s.max_ref_velocity_jump / k << " " << unit << "/s between samples (largest; position bound "
     << kMaxReferenceJump / k << " " << unit << ")";
@@ -637,7 +658,8 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
 ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
                                  const std::optional<Scenario>& scenario,
                                  const PseudoControlBound& pseudo_control_bound,
-                                 const std::string& bus_keyring) {
+                                 const std::string& bus_keyring,
+                                 const std::optional<ControlStops>& control_stops) {
   namespace fs = std::filesystem;
   // Checked before any folder or file is made.
   lcm::LogFile log(log_path, "r");
@@ -664,6 +686,7 @@ ReportResult write_flight_report(const std::string& log_path, const std::string&
   j.start_gate = scenario ? scenario->start_gate : std::nullopt;
   j.finish_gate = scenario ? scenario->finish_gate : std::nullopt;
   j.pseudo_control_bound = pseudo_control_bound;
+  if (control_stops) j.saturation = control_saturation(record.commands, *control_stops);
   j.scan_to_plan = scan_to_plan_latencies(record.map_stamps, record.plan_steps);
   j.unit = DisplayUnit{scenario ? scenario->display_unit : "m",
                        scenario ? scenario->metres_per_unit : 1.0};

@@ -43,8 +43,10 @@ int main(int argc, char** argv) {
     const auto controller = ofn::control::load_controller_config(controller_reader);
     const ofn::report::PseudoControlBound bound{controller.gains.max_horizontal_accel,
                                                 controller.gains.max_vertical_accel};
+    const ofn::report::ControlStops stops{controller.nominal.min_controls.as_array(),
+                                          controller.nominal.max_controls.as_array()};
     const auto result =
-        ofn::report::write_flight_report(log_path, out_dir, scenario, bound, bus_keys);
+        ofn::report::write_flight_report(log_path, out_dir, scenario, bound, bus_keys, stops);
     std::cout << result.text;
     return result.verdict.outcome == ofn::report::Outcome::kFailure ? 1 : 0;
   });

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -74,6 +75,37 @@ TEST(CrossingTime, FirstCrossingCounts) {
   // Forward past 10, back, and forward again: the first crossing is timed.
   const std::vector<NavSample> samples = {nav(0, 0), nav(1, 20), nav(2, 0), nav(3, 20)};
   EXPECT_NEAR(*crossing_time(samples, 10.0), 0.5, 1e-12);
+}
+
+// The controller as shipped: collective, longitudinal and lateral cyclic, pedal.
+const ControlStops kStops{{-0.05, -0.16, -0.16, -0.40}, {0.30, 0.16, 0.16, 0.40}};
+
+TEST(ControlSaturation, SharesOfCommandsAtAStopPerChannelAndTogether) {
+  const std::vector<std::array<double, 4>> commands = {
+      {0.10, 0.00, 0.00, 0.00},    // inside every stop
+      {0.10, 0.16, 0.00, 0.00},    // longitudinal cyclic at its upper stop
+      {0.10, 0.00, -0.16, 0.00},   // lateral cyclic at its lower stop
+      {0.10, -0.16, 0.159, 0.0},   // both cyclics (0.159 is within 0.5 % of the range)
+      {0.30, 0.00, 0.00, -0.40},   // collective and pedal, no cyclic
+      {0.10, 0.155, 0.00, 0.00}};  // 0.005 short of the stop: not at it
+  const ControlSaturation c = control_saturation(commands, kStops);
+  EXPECT_EQ(c.samples, 6u);
+  EXPECT_DOUBLE_EQ(c.share[0], 1.0 / 6.0);
+  EXPECT_DOUBLE_EQ(c.share[1], 2.0 / 6.0);
+  EXPECT_DOUBLE_EQ(c.share[2], 2.0 / 6.0);
+  EXPECT_DOUBLE_EQ(c.share[3], 1.0 / 6.0);
+  EXPECT_DOUBLE_EQ(c.cyclic_share, 3.0 / 6.0);
+  EXPECT_DOUBLE_EQ(c.any_share, 4.0 / 6.0);
+}
+
+TEST(ControlSaturation, NoCommandsAndNonFiniteOnesAreAtNoStop) {
+  const ControlSaturation none = control_saturation({}, kStops);
+  EXPECT_EQ(none.samples, 0u);
+  EXPECT_EQ(none.any_share, 0.0);
+  const double nan = std::nan("");
+  const ControlSaturation bad = control_saturation({{nan, nan, nan, nan}}, kStops);
+  EXPECT_EQ(bad.samples, 1u);
+  EXPECT_EQ(bad.any_share, 0.0);
 }
 
 TEST(AnalyseFlight, GateToGateAtTenMetresPerSecond) {

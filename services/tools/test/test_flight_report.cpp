@@ -14,6 +14,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
+#include "ofn/actuator_cmd_t.hpp"
 #include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
@@ -152,6 +153,43 @@ TEST_F(FlightReport, AHoverIsTabledAndSummarised) {
   EXPECT_NEAR(json.at("min_clearance").get<double>(), *result.min_clearance, 1e-12);
   EXPECT_EQ(json.at("failures").size(), result.verdict.failures.size());
   EXPECT_EQ(json.at("obstacles").size(), open.obstacles.size());
+}
+
+// With the controller's stops the summary says how much of the flight a
+// control was at one; without them it says nothing (null), not zero.
+TEST_F(FlightReport, ControlsAtAStopAreSharesOfTheCommands) {
+  const Scenario open = load_scenario(kOpenScenario);
+  const std::string path = hover_log("hover.lcm", open.start_position, 1.0);
+  {
+    lcm::LogFile log(path, "a");
+    ASSERT_TRUE(log.good());
+    const Utime t0 = 1000 * kMicrosPerSecond;
+    for (int i = 0; i < 100; ++i) {
+      actuator_cmd_t m{};
+      m.utime = t0 + i * 10000;
+      m.collective = 0.1;
+      m.lon_cyclic = i < 25 ? 0.16 : 0.02;   // the first quarter at the forward stop
+      m.lat_cyclic = i >= 90 ? -0.16 : 0.0;  // the last tenth at the left stop
+      write(log, channels::kActuatorCmd, m, m.utime);
+    }
+  }
+  const ControlStops stops{{-0.05, -0.16, -0.16, -0.40}, {0.30, 0.16, 0.16, 0.40}};
+  const ReportResult result =
+      write_flight_report(path, (dir_ / "report").string(), open, PseudoControlBound{}, "", stops);
+  const nlohmann::json json = read_json(dir_ / "report" / "summary.json");
+  const nlohmann::json& at_stop = json.at("controls_at_stop");
+  EXPECT_EQ(at_stop.at("samples"), 100);
+  EXPECT_DOUBLE_EQ(at_stop.at("lon_cyclic").get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(at_stop.at("lat_cyclic").get<double>(), 0.10);
+  EXPECT_DOUBLE_EQ(at_stop.at("cyclic").get<double>(), 0.35);
+  EXPECT_DOUBLE_EQ(at_stop.at("collective").get<double>(), 0.0);
+  EXPECT_NE(
+      result.text.find("controls at a stop: 35.0 % of the commands with a cyclic at its stop"),
+      std::string::npos)
+      << result.text;
+
+  write_flight_report(path, (dir_ / "no-stops").string(), open, PseudoControlBound{});
+  EXPECT_TRUE(read_json(dir_ / "no-stops" / "summary.json").at("controls_at_stop").is_null());
 }
 
 // The time in dead-end recovery counts the steps the optimiser marks as

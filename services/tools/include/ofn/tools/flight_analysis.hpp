@@ -3,6 +3,7 @@
 // samples, and the benchmark verdict on them. Pure core: plain vectors (and
 // the true world, for the clearance) in, a summary and a verdict out.
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -81,6 +82,33 @@ struct PseudoControlBound {
   double horizontal = 0;  // m/s^2, norm of the north-east part
   double vertical = 0;    // m/s^2, |down part|
 };
+
+/// The controller's actuator stops (its config's nominal_airframe
+/// min_controls / max_controls), per channel: collective, longitudinal
+/// cyclic, lateral cyclic, pedal (rad).
+struct ControlStops {
+  std::array<double, 4> min{};
+  std::array<double, 4> max{};
+};
+
+/// How much of the flight the controller asked for all a channel has: the
+/// share of ACTUATOR_CMD samples with the channel at a stop. Not a verdict
+/// rule but a measure of the authority a flight used up: the seven courses
+/// and calm dense fields have the cyclic at a stop well under 1 % of the
+/// time, a gusty field far more (docs/RESULTS.md), and while it is there the
+/// controller cannot hold the reference, whatever it was planned with.
+struct ControlSaturation {
+  size_t samples = 0;
+  std::array<double, 4> share{};  // per channel, 0..1
+  double cyclic_share = 0;        // either cyclic channel at a stop
+  double any_share = 0;           // any channel at a stop
+};
+/// A channel is at a stop within kStopBand of its range from it.
+constexpr double kStopBand = 0.005;
+/// Commands in the channel order of ControlStops; non-finite ones count as
+/// at no stop.
+ControlSaturation control_saturation(const std::vector<std::array<double, 4>>& commands,
+                                     const ControlStops& stops);
 
 /// The three ways a run ends (../shared/BENCHMARKS.md, "What a run
 /// reports").

@@ -40,11 +40,14 @@ struct ReportResult {
 /// `pseudo_control_bound` is the bound of the controller that flew.
 /// `bus_keyring`, if given, is a keyring directory of the authenticated bus
 /// the log was recorded on (its policy.yaml and public keys): only what its
-/// roles signed on their channels is read. Throws std::invalid_argument if
-/// the log or the keyring cannot be read.
+/// roles signed on their channels is read. `control_stops`, if given, are
+/// the controller's actuator stops: the summary then tells how much of the
+/// flight a channel was at one (ControlSaturation). Throws
+/// std::invalid_argument if the log or the keyring cannot be read.
 ReportResult write_flight_report(const std::string& log_path, const std::string& out_dir,
                                  const std::optional<Scenario>& scenario,
                                  const PseudoControlBound& pseudo_control_bound,
-                                 const std::string& bus_keyring = "");
+                                 const std::string& bus_keyring = "",
+                                 const std::optional<ControlStops>& control_stops = std::nullopt);
 
 }  // namespace ofn::report
