@@ -168,7 +168,7 @@ ControlOutput TrajectoryController::step(const Reference& ref, const VehicleEsti
   inner_loop(ref.yaw_rate, x, s, &out);
   clamp_to_actuator_limits(&out);
   hedge(x.body_rates, s, &out);
-  if (!adaptation_held_) adaptive_->update(s.ad);
+  adaptive_->update(s.ad);
   advance_reference_models(s, &out);
 
   const bool states_finite = ref_position_.allFinite() && ref_velocity_.allFinite() &&

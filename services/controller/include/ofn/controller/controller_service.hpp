@@ -55,7 +55,6 @@ class ControllerService {
   Node& node() { return node_; }
   int8_t mode() const { return mode_; }
   bool sweeping() const { return sweeping_; }
-  bool adaptation_held() const { return controller_.adaptation_held(); }
 
  private:
   void on_nav(const nav_state_t& m) { nav_ = m; }

@@ -151,14 +151,6 @@ class TrajectoryController {
   /// `governor_over_limit`); far below it does nothing.
   /// Zero turns a limit off (the default).
   void set_speed_limits(double max_speed, double max_vertical_speed);
-  /// Holds the adaptive element's weights (it still adds what it has
-  /// learnt) while `hold` is true. The service no longer holds them: held
-  /// at a hover and through a look-around they were learnt for another
-  /// heading to the wind, and in wind the vehicle lost control after a
-  /// look-around (docs/TUNING.md); the adaptive-control tests still use
-  /// it.
-  void hold_adaptation(bool hold) { adaptation_held_ = hold; }
-  bool adaptation_held() const { return adaptation_held_; }
   /// Level-attitude hover command, the safe output when inputs are bad.
   vehicle::Controls hover_command() const { return hover_; }
   const ControllerGains& gains() const { return gains_; }
@@ -202,7 +194,6 @@ class TrajectoryController {
   Vec3 position_integral_ = Vec3::Zero();
   double governed_speed_ = 0;           // m/s, 0: no governor
   double governed_vertical_speed_ = 0;  // m/s, 0: no governor
-  bool adaptation_held_ = false;
   Vec3 attitude_integral_ = Vec3::Zero();
   double tail_thrust_estimate_ = 0;  // N, side force of the tail rotor
   double hover_tail_thrust_ = 0;     // N, its hover value, after a reset
