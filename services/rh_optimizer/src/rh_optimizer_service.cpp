@@ -85,6 +85,7 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
       r.number_in("replan_position_error", c.replan_position_error, 0.0, 1000.0);
   c.replan_velocity_error =
       r.number_in("replan_velocity_error", c.replan_velocity_error, 0.0, 100.0);
+  c.stop_recapture_error = r.number_in("stop_recapture_error", c.stop_recapture_error, 0.0, 1000.0);
   c.defer_margin = r.number_in("defer_margin", c.defer_margin, 0.0, 1000.0);
 
   YamlReader field = r.child("distance_field");
@@ -483,6 +484,7 @@ void RhOptimizerService::restart_planning() {
   recovery_.reset();
   last_step_moving_ = false;
   last_trajectory_ = BsplineTrajectory();
+  last_trajectory_kind_ = LastPlan::kMoving;
   stopping_at_target_ = false;
   stalled_ = false;
 }
@@ -703,10 +705,11 @@ void RhOptimizerService::tick() {
   start_rules.replan_position_error = config_.replan_position_error;
   start_rules.replan_velocity_error = config_.replan_velocity_error;
   start_rules.planned_initial_acceleration = config_.planned_initial_acceleration;
-  const StartState start =
-      choose_start_state(last_trajectory_, to_seconds(now - last_trajectory_t0_),
-                         MeasuredState{position, velocity, to_vec3(nav_->acceleration)},
-                         mission_->limits.max_accel, start_rules);
+  start_rules.stop_recapture_error = config_.stop_recapture_error;
+  const StartState start = choose_start_state(
+      last_trajectory_, last_trajectory_kind_, to_seconds(now - last_trajectory_t0_),
+      MeasuredState{position, velocity, to_vec3(nav_->acceleration)}, mission_->limits.max_accel,
+      start_rules);
   FramingSettings framing;
   framing.clearance_margin = config_.optimizer.clearance_margin;
   framing.pinch_clearance = pinch_clearance(limits);
@@ -734,6 +737,7 @@ void RhOptimizerService::tick() {
     node_.publish(channels::kRefTraj,
                   trajectory_message(hover, t0, mode, config_.sample_period, now));
     last_trajectory_ = hover;
+    last_trajectory_kind_ = LastPlan::kStop;
     last_trajectory_t0_ = t0;
     last_step_moving_ = false;
     note(std::string("recovery: ") + to_string(recovery.phase));
@@ -783,6 +787,7 @@ void RhOptimizerService::tick() {
   node_.publish(channels::kRefTraj,
                 trajectory_message(out.trajectory, t0, mode, config_.sample_period, now));
   last_trajectory_ = out.trajectory;
+  last_trajectory_kind_ = out.mode == StepMode::kBraking ? LastPlan::kStop : LastPlan::kMoving;
   last_trajectory_t0_ = t0;
   std::string message = recovery_message(recovery.phase, to_string(out.mode));
   if (!out.reason.empty()) message += ": " + out.reason;

@@ -30,6 +30,7 @@
 #include "ofn/rh_optimizer/occlusion.hpp"
 #include "ofn/rh_optimizer/rh_planner.hpp"
 #include "ofn/rh_optimizer/scan_supply.hpp"
+#include "ofn/rh_optimizer/start_state.hpp"
 #include "ofn/rh_optimizer/tracking_tube.hpp"
 #include "ofn/scan_world_t.hpp"
 #include "ofn/solver_stats_t.hpp"
@@ -65,6 +66,8 @@ struct RhOptimizerServiceConfig {
   bool planned_initial_state = true;
   double replan_position_error = 3.0;  // m; farther from the plan, start from the vehicle
   double replan_velocity_error = 1.5;  // m/s
+  /// A stop is held while the vehicle is within this of it (start_state.hpp).
+  double stop_recapture_error = 6.0;  // m
   // Before a first avoidance trajectory exists, a failed solve brakes only
   // if the conflict is within braking distance plus this; otherwise nominal
   // guidance continues (DEFERRED) and the next tick tries again, typically
@@ -195,6 +198,7 @@ class RhOptimizerService {
   DeadEndRecovery recovery_;
   PassageMemory passages_;
   bool last_step_moving_ = false;  // the last step committed a plan that moves off
+  LastPlan last_trajectory_kind_ = LastPlan::kMoving;  // what last_trajectory_ is
   Utime route_utime_ = INT64_MIN;
   bool route_changed_ = false;
   BsplineTrajectory last_trajectory_;  // last published, for a(t0)
