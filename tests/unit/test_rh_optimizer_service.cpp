@@ -216,6 +216,48 @@ TEST_F(RhOptimizerServiceTest, AWallAheadEngagesAvoidanceOverIt) {
   EXPECT_GT(stats_.back().iterations, 0);
 }
 
+// A stop is held against a gust: a vehicle pushed off it (4 m aside and
+// 2 m/s faster towards the wall, past both replan errors of a moving plan)
+// gets the same stop again, to be flown back to, not a new one starting
+// with the gust's velocity.
+TEST_F(RhOptimizerServiceTest, AGustDoesNotMoveAStop) {
+  send(channels::kMission, mission());
+  // A wall too tall to climb 13 m ahead at cruise speed: nothing to solve
+  // but a stop.
+  step(Vec3(0, 0, -kAltitude), 13.0, 300.0);
+  ASSERT_TRUE(service_.engaged());
+  ASSERT_FALSE(trajs_.empty());
+  ASSERT_EQ(trajs_.back().mode, ref_traj_t::BRAKING);
+  // The vehicle flies the stop for a few steps.
+  for (int i = 0; i < 3; ++i) {
+    ref_traj_t flown = trajs_.back();
+    expand_ref_traj(flown);
+    const auto now = sample_ref_traj_at(flown, to_seconds(bus_.now() + 50000 - flown.t0_utime));
+    ASSERT_TRUE(now.has_value());
+    step(now->position, 13.0, 300.0, now->velocity);
+  }
+  ref_traj_t stop = trajs_.back();
+  expand_ref_traj(stop);
+  const size_t published = trajs_.size();
+  const Utime gust_time = bus_.now() + 50000;
+  const auto held = sample_ref_traj_at(stop, to_seconds(gust_time - stop.t0_utime));
+  ASSERT_TRUE(held.has_value());
+  const Vec3 pushed = held->position + Vec3(0, 4.0, 0);
+  const Vec3 gusted = held->velocity + Vec3(2.0, 0, 0);
+  step(pushed, 13.0, 300.0, gusted);
+  ASSERT_GT(trajs_.size(), published);
+  ref_traj_t next = trajs_.back();
+  expand_ref_traj(next);
+  // It starts where the stop is at its start time.
+  const auto start = sample_ref_traj_at(next, 0.0);
+  const auto on_stop = sample_ref_traj_at(stop, to_seconds(next.t0_utime - stop.t0_utime));
+  ASSERT_TRUE(start.has_value() && on_stop.has_value());
+  EXPECT_LT((start->position - on_stop->position).norm(), 0.01);
+  EXPECT_LT((start->velocity - on_stop->velocity).norm(), 0.01);
+  EXPECT_GT((start->position - pushed).norm(), 3.5);
+  EXPECT_GT((start->velocity - gusted).norm(), 1.5);
+}
+
 TEST_F(RhOptimizerServiceTest, HandsBackWithANominalTrajectoryOnceClearAndOnTheLeg) {
   send(channels::kMission, mission());
   for (int i = 0; i < 3; ++i) step(Vec3(0, 0, -kAltitude), 45.0, 42.7);
