@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "ofn/common/command_line.hpp"
 #include "ofn/common/config.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/controller/controller_service.hpp"
@@ -30,7 +31,8 @@ struct AirframeError {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn tracking sweep: adaptive vs non-adaptive tracking error"};
+  ofn::CommandLine app{"ofn_tracking_sweep",
+                       "ofn tracking sweep: adaptive vs non-adaptive tracking error"};
   std::string scenario_path = std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml";
   std::string out_dir = std::string(OFN_SOURCE_DIR) + "/results/bench";
   std::string config_path = std::string(OFN_SOURCE_DIR) + "/config/controller.yaml";
@@ -45,10 +47,10 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--out", out_dir, "folder for tracking_sweep.md and tracking_sweep.csv");
   app.add_option("--duration", duration, "s of flight per case (the route is flown back and forth)")
-      ->check(CLI::PositiveNumber);
+      ->check(ofn::positive_number());
   app.add_option("--turbulence", turbulence, "turbulence on every windy case")
       ->check(CLI::IsMember({"none", "light", "moderate", "severe"}));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   ofn::Scenario base;
   ofn::sim::TrackingSetup tuned;

@@ -127,7 +127,8 @@ void print_summary(const ofn::Scenario& scenario, const ofn::baseline::BaselineR
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn baseline: offline time-optimal gate-to-gate time of a course"};
+  ofn::CommandLine app{"ofn_baseline",
+                       "ofn baseline: offline time-optimal gate-to-gate time of a course"};
   std::string scenario_path, out_dir;
   bool quiet = false;
   app.add_option("--scenario", scenario_path, "scenario file (YAML) with timing gates")->required();
@@ -136,20 +137,16 @@ int main(int argc, char** argv) {
   ofn::baseline::BaselineSettings settings;
   app.add_option("--knot-spacing", settings.knot_spacing,
                  "s of trajectory per B-spline interval (finer: closer to the optimum, slower)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(ofn::positive_number());
   app.add_option("--sample-spacing", settings.sample_spacing,
                  "s between the constraint samples of the programme")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(ofn::positive_number());
   app.add_option("--run-up-weight", settings.run_up_weight,
                  "cost of a second before the start gate against one between the gates "
                  "(1: fastest whole flight; near 0: least gate-to-gate time, any run-up)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(ofn::number_between(0.0, 1.0));
   app.add_option("--max-solve-time", settings.max_solve_time, "s of computation per initial guess")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(ofn::positive_number());
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
   ofn::Scenario scenario;
   try {

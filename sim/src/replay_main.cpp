@@ -12,7 +12,8 @@
 #include "ofn/sim/replay.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  ofn::CommandLine app{
+      "ofn_replay",
       "ofn log replay: feeds a recorded flight's inputs into fresh sensor_interface, mapper, "
       "global_planner and rh_optimizer services and compares their outputs with the recording. "
       "Exit 0: every compared channel matches; 1: they differ; 2: bad input."};
@@ -27,24 +28,21 @@ int main(int argc, char** argv) {
                      "folder with sensor_interface.yaml, mapper.yaml, global_planner.yaml, "
                      "rh_optimizer.yaml (missing files: defaults)");
   app.add_option("--out", out_dir, "folder for replayed.lcm (recorded inputs, replayed outputs)");
-  app.add_option("--services", service_list, "comma-separated services to replay")
-      ->capture_default_str();
+  app.add_option("--services", service_list, "comma-separated services to replay");
   app.add_option("--clock", clock,
                  "replay clock: log (log timestamps), sim (SIM_CLOCK messages), auto (log for "
                  "simulation-time logs, sim for wall-time logs with SIM_CLOCK)")
-      ->check(CLI::IsMember({"auto", "log", "sim"}))
-      ->capture_default_str();
+      ->check(CLI::IsMember({"auto", "log", "sim"}));
   app.add_option("--tolerance", tolerance,
                  "largest field difference (m, s, m/s, cost) still counted as a match; 0: "
                  "identical bytes")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ofn::non_negative_number());
   app.add_option("--stamp-tolerance", stamp_tolerance,
                  "largest time-stamp difference (s) still counted as a match; for logs of "
                  "services that followed SIM_CLOCK in real time")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ofn::non_negative_number());
   app.add_option("--log-level", log_level, "services' log level")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
-  app.failure_message(CLI::FailureMessage::help);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_replay", [&]() -> int {

@@ -40,7 +40,8 @@ ofn::YamlReader config_in(const std::string& dir, const std::string& file) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn lockstep runner: all services in one process, deterministic and fast"};
+  ofn::CommandLine app{"ofn_sim_runner",
+                       "ofn lockstep runner: all services in one process, deterministic and fast"};
   std::string scenario_path, config_dir = "config", out_dir, log_path, log_level = "warn";
   std::string process_table = "deploy/processes.yaml";
   double max_time = 0, linger = 2.0, link_loss = 0.0, link_delay = 0.0, link_jitter = 0.0;
@@ -54,27 +55,27 @@ int main(int argc, char** argv) {
                  "mapper.yaml, global_planner.yaml, rh_optimizer.yaml (missing files: defaults)");
   app.add_option("--out", out_dir, "folder for the log, CSV files and summary (default: none)");
   app.add_option("--log", log_path, "LCM log to write (default: <out>/flight.lcm)");
-  app.add_option("--max-time", max_time, "simulated seconds before giving up (default: scenario)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--max-time", max_time,
+                 "simulated seconds before giving up (default: the scenario's max_time)")
+      ->check(ofn::positive_number());
   app.add_option("--linger", linger, "simulated seconds to keep flying after arrival");
   app.add_option("--log-level", log_level, "service log level")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.add_option("--link-loss", link_loss,
                  "probability that a datagram between two hosts is lost (hosts from "
                  "--process-table; a message is lost when any of its fragments is)")
-      ->check(CLI::Range(0.0, 0.99));
+      ->check(ofn::number_between(0.0, 0.99));
   app.add_option("--link-delay", link_delay, "s every message between two hosts is delayed")
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(ofn::number_between(0.0, 10.0));
   app.add_option("--link-jitter", link_jitter,
                  "s of uniform jitter (+-) on that delay; messages then overtake one another")
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(ofn::number_between(0.0, 10.0));
   app.add_flag("--link-all", link_all,
                "the link faults also between the services of one host (the controller-vehicle "
                "loop included)");
-  app.add_option("--link-seed", link_seed, "seed of the link-fault draws")->capture_default_str();
+  app.add_option("--link-seed", link_seed, "seed of the link-fault draws");
   app.add_option("--process-table", process_table,
-                 "process table naming each service's host, for the link faults")
-      ->capture_default_str();
+                 "process table naming each service's host, for the link faults");
   app.add_flag("--quiet", quiet, "no progress lines");
   app.add_flag("--no-avoidance", no_avoidance,
                "fly without global_planner and rh_optimizer (nominal waypoint guidance only)");
@@ -82,7 +83,6 @@ int main(int argc, char** argv) {
       "Exit code: with --out, 0 when the flight's outcome is success or safe_stop and 1 "
       "when it is failure; without --out (no report, no verdict), 0 when the vehicle "
       "arrived and 1 when not; 2 for bad arguments, config or scenario.");
-  app.failure_message(CLI::FailureMessage::help);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_sim_runner", [&]() -> int {

@@ -29,6 +29,7 @@
 #include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
+#include "ofn/common/command_line.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/heartbeat_t.hpp"
@@ -124,20 +125,22 @@ void publish_forgeries(lcm::LCM& lcm, ofn::Utime now) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"publish garbage on every channel and check that services reject it"};
+  ofn::CommandLine app{"ofn_bus_fuzz",
+                       "publish garbage on every channel and check that services reject it"};
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
   std::vector<std::string> services;
   int rounds = 200;
-  app.add_option("--lcm-url", url);
+  app.add_option("--lcm-url", url, "LCM URL of the bus to attack");
   app.add_option("--rounds", rounds, "garbage messages per channel and kind");
   app.add_option("--expect", services, "services that must stay alive and count rejections")
       ->required();
   std::string sign_as, bus_keys;
   app.add_option("--sign-as", sign_as,
                  "sign the well-formed forgeries with this role's key from --bus-keys, as "
-                 "if that host signed channels it may not publish");
-  app.add_option("--bus-keys", bus_keys, "keyring holding the --sign-as role's key");
-  CLI11_PARSE(app, argc, argv);
+                 "if that host signed channels it may not publish (default: none, unsigned)");
+  app.add_option("--bus-keys", bus_keys,
+                 "keyring holding the --sign-as role's key (default: none)");
+  if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
   if (!sign_as.empty()) {
     // The stranger's own signer lets it sign anything; receivers judge.
     const std::string dir = bus_keys + "/";

@@ -17,15 +17,13 @@ int main(int argc, char** argv) {
   std::string policy_path = "config/bus_policy.yaml";
   std::string out;
   bool force = false;
-  CLI::App app{
+  ofn::CommandLine app{
+      "ofn_bus_keygen",
       "Makes the keyring of an authenticated bus: an Ed25519 key pair per role of the "
       "publish policy, and the policy, in one directory (docs/DEPLOYMENT.md).\n"
       "Give each host policy.yaml, every *.pub and only its own <role>.key; start its "
       "services with --bus-keys DIR --bus-role ROLE (deploy/launch.py --bus-keys DIR)."};
-  app.failure_message(CLI::FailureMessage::help);
-  app.add_option("--policy", policy_path, "publish policy (YAML)")
-      ->check(CLI::ExistingFile)
-      ->capture_default_str();
+  app.add_option("--policy", policy_path, "publish policy (YAML)")->check(CLI::ExistingFile);
   app.add_option("--out", out, "keyring directory to make")->required();
   app.add_flag("--force", force, "replace the keys of an existing keyring");
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;

@@ -23,11 +23,11 @@ void on_signal(int) {
 
 }  // namespace
 
-void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock, bool with_config) {
-  // A bad command line prints the whole usage, not just the complaint.
-  app.failure_message(CLI::FailureMessage::help);
+void add_common_options(CommandLine& app, CommonOptions& options, bool with_clock,
+                        bool with_config) {
   if (with_config)
-    app.add_option("--config", options.config, "service configuration file (YAML)")
+    app.add_option("--config", options.config,
+                   "service configuration file (YAML) (default: none, the built-in defaults)")
         ->check(CLI::ExistingFile);
   app.add_option("--lcm-url", options.lcm_url,
                  "LCM URL (default: $LCM_DEFAULT_URL or " + std::string(kDefaultLcmUrl) + ")");
@@ -40,7 +40,8 @@ void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock, 
                  "open bus)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--bus-role", options.bus_role,
-                 "authenticated bus: this host's role in the keyring (gcs, onboard1, onboard2)");
+                 "authenticated bus: this host's role in the keyring (gcs, onboard1, onboard2); "
+                 "needed with --bus-keys (default: none)");
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
 }
@@ -147,15 +148,6 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
     }
   }
   return 0;
-}
-
-std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : kExitInputError;
-  }
-  return std::nullopt;
 }
 
 int guarded_main(const std::string& program, const std::function<int()>& body) {

@@ -7,7 +7,8 @@
 #include "ofn/controller/controller_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn controller: trajectory follower and waypoint guidance"};
+  ofn::CommandLine app{"ofn_controller",
+                       "ofn controller: trajectory follower and waypoint guidance"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;

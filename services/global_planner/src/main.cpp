@@ -6,7 +6,9 @@
 #include "ofn/global_planner/global_planner_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn global_planner: dynamic programming over the cuboid node graph (GLOBAL_PATH)"};
+  ofn::CommandLine app{
+      "ofn_global_planner",
+      "ofn global_planner: dynamic programming over the cuboid node graph (GLOBAL_PATH)"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;

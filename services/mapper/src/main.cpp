@@ -6,7 +6,8 @@
 #include "ofn/mapper/mapper_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn mapper: obstacle grid (OBSTACLE_GRID) and cuboid database (CUBOIDS)"};
+  ofn::CommandLine app{"ofn_mapper",
+                       "ofn mapper: obstacle grid (OBSTACLE_GRID) and cuboid database (CUBOIDS)"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;

@@ -6,7 +6,8 @@
 #include "ofn/mission_uplink/mission_uplink_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn mission_uplink: publishes a scenario's waypoint plan as MISSION"};
+  ofn::CommandLine app{"ofn_mission_uplink",
+                       "ofn mission_uplink: publishes a scenario's waypoint plan as MISSION"};
   ofn::CommonOptions options;
   std::string scenario_path;
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);

@@ -7,7 +7,9 @@
 #include "ofn/obstacle_injector/obstacle_injector_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn obstacle_injector: publishes a scenario's obstacles as VIRTUAL_OBSTACLES"};
+  ofn::CommandLine app{
+      "ofn_obstacle_injector",
+      "ofn obstacle_injector: publishes a scenario's obstacles as VIRTUAL_OBSTACLES"};
   ofn::CommonOptions options;
   std::string scenario_path;
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/true);

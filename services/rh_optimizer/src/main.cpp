@@ -7,7 +7,9 @@
 #include "ofn/rh_optimizer/rh_optimizer_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn rh_optimizer: B-spline trajectory optimisation in sensor range (REF_TRAJ)"};
+  ofn::CommandLine app{
+      "ofn_rh_optimizer",
+      "ofn rh_optimizer: B-spline trajectory optimisation in sensor range (REF_TRAJ)"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;

@@ -8,7 +8,8 @@
 #include "ofn/sensor_interface/sensor_interface_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn sensor_interface: LIDAR scans to world-frame points"};
+  ofn::CommandLine app{"ofn_sensor_interface",
+                       "ofn sensor_interface: LIDAR scans to world-frame points"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;

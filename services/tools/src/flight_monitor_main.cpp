@@ -34,7 +34,8 @@
 #include "ofn/tools/monitor_line.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn flight monitor: progress of a live flight; exits when it is done"};
+  ofn::CommandLine app{"ofn_flight_monitor",
+                       "ofn flight monitor: progress of a live flight; exits when it is done"};
   ofn::CommonOptions options;
   double timeout = 300.0, report_period = 5.0, linger = 1.0;
   std::string scenario_path;
@@ -45,23 +46,20 @@ int main(int argc, char** argv) {
                                       "global_planner",    "rh_optimizer"};
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
   app.add_option("--timeout", timeout, "give up after this many wall seconds (0: never)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ofn::non_negative_number());
   app.add_option("--every", report_period, "seconds of flight time between progress lines")
-      ->check(CLI::PositiveNumber);
+      ->check(ofn::positive_number());
   app.add_option("--linger", linger,
                  "seconds of flight time over which every status must say DONE, with the "
                  "vehicle at the last waypoint, before the flight counts as arrived")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ofn::non_negative_number());
   app.add_option("--scenario", scenario_path,
                  "scenario file: progress in its unit (feet for the courses); without it, metres");
   app.add_option("--silence", silence,
                  "wall seconds without a heartbeat after which a service is reported silent "
                  "(0: no report)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--services", watched, "services whose heartbeats are watched")
-      ->delimiter(',')
-      ->capture_default_str();
+      ->check(ofn::non_negative_number());
+  app.add_option("--services", watched, "services whose heartbeats are watched")->delimiter(',');
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_flight_monitor", [&] {

@@ -12,7 +12,8 @@
 #include "ofn/tools/flight_report.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn flight report: turns an LCM flight log into CSV files and a summary"};
+  ofn::CommandLine app{"ofn_flight_report",
+                       "ofn flight report: turns an LCM flight log into CSV files and a summary"};
   std::string log_path, out_dir, scenario_path, controller_config_path, bus_keys;
   app.add_option("--log", log_path, "LCM log file (lcm-logger output)")
       ->required()
@@ -27,12 +28,12 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--bus-keys", bus_keys,
                  "keyring of the authenticated bus the log was recorded on (its policy.yaml "
-                 "and public keys): read only what its roles signed on their channels")
+                 "and public keys): read only what its roles signed on their channels (default: "
+                 "none, every message read)")
       ->check(CLI::ExistingDirectory);
   app.footer(
       "Exit code: 0 when the flight's outcome is success or safe_stop, 1 when it is "
       "failure, 2 for bad arguments or an unreadable log.");
-  app.failure_message(CLI::FailureMessage::help);
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
   return ofn::guarded_main("ofn_flight_report", [&] {
     std::optional<ofn::Scenario> scenario;

@@ -10,7 +10,8 @@
 #include "ofn/vehicle_sim/vehicle_sim_service.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn vehicle_sim: 6-DOF RMAX-class rotorcraft simulation"};
+  ofn::CommandLine app{"ofn_vehicle_sim",
+                       "ofn vehicle_sim: 6-DOF RMAX-class rotorcraft simulation"};
   ofn::CommonOptions options;
   std::string scenario_path;
   double real_time_factor = 1.0;
@@ -18,10 +19,11 @@ int main(int argc, char** argv) {
   ofn::add_common_options(app, options, /*with_clock=*/false);
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")->required();
   app.add_option("--real-time-factor", real_time_factor, "simulation speed, 1 = real time")
-      ->check(CLI::Range(0.01, 1000.0));
+      ->check(ofn::number_between(0.01, 1000.0));
   app.add_option("--checkpoint", checkpoint_path,
                  "file the flight's state is saved to as it flies; when it exists at the start, "
-                 "the flight resumes from it (a restart after a crash)");
+                 "the flight resumes from it (a restart after a crash) (default: none, no "
+                 "checkpoint)");
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_vehicle_sim", [&] {

@@ -38,15 +38,10 @@ void enter_network_namespace(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn viewer: the flight live in a browser (top view, altitude, plans, status)"};
-  app.set_version_flag("--version", std::string("ofn_viewer ") + OFN_VERSION);
-  app.option_defaults()->always_capture_default();
+  ofn::CommandLine app{
+      "ofn_viewer", "ofn viewer: the flight live in a browser (top view, altitude, plans, status)"};
   ofn::CommonOptions options;
   ofn::add_common_options(app, options, /*with_clock=*/true, /*with_config=*/false);
-  // One line for a usage error, not the whole help.
-  app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    return std::string("ofn_viewer: error: ") + e.what() + " (see --help)\n";
-  });
   std::string address = "127.0.0.1";
   int port = 8765;
   std::string lcm_netns;
@@ -62,22 +57,22 @@ int main(int argc, char** argv) {
   app.add_option("--web-root", web_root, "folder with the page (index.html, viewer.js)");
   app.add_option("--url-file", url_file, "write the page's URL to this file once it is served");
   app.add_option("--rate", rate, "snapshots per second of the clock")
-      ->check(CLI::Range(0.1, 100.0));
+      ->check(ofn::number_between(0.1, 100.0));
   app.add_option("--units", view.display_unit, "length unit the page shows")
       ->check(CLI::IsMember({"ft", "m"}));
   app.add_option("--trail-points", view.trail_max_points, "vehicle trail points kept")
       ->check(CLI::Range(2, 1000000));
   app.add_option("--stale-after", view.stale_after,
                  "s of navigation time after which a layer is shown stale")
-      ->check(CLI::PositiveNumber);
+      ->check(ofn::positive_number());
   app.add_option("--ref-traj-timeout", view.ref_traj_timeout,
                  "s the controller flies a plan past its stamp before its stop (controller "
                  "ref_traj_timeout)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ofn::non_negative_number());
   app.add_option("--stop-accel-fraction", view.stop_accel_fraction,
                  "deceleration of the plan's stop, share of the acceleration limit (controller "
                  "reference_selector.stop_accel_fraction)")
-      ->check(CLI::Range(0.01, 1.0));
+      ->check(ofn::number_between(0.01, 1.0));
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
 
   return ofn::guarded_main("ofn_viewer", [&] {

@@ -1,10 +1,10 @@
 #pragma once
 // What every service's main() shares: the common command-line options, the
 // clock they select and the process loop that runs nodes on a udpm:// (or
-// any) LCM URL until SIGINT/SIGTERM.
+// any) LCM URL until SIGINT/SIGTERM. The command line itself, its
+// convention and the exit codes: command_line.hpp.
 
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +12,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "ofn/common/clock.hpp"
+#include "ofn/common/command_line.hpp"
 #include "ofn/common/node.hpp"
 
 namespace ofn {
@@ -31,9 +32,9 @@ struct CommonOptions {
   std::string bus_role;
 };
 
-/// Adds --lcm-url and --log-level, and --clock / --config for programs that
-/// have a clock choice or a config file.
-void add_common_options(CLI::App& app, CommonOptions& options, bool with_clock = true,
+/// Adds --lcm-url, --bus-keys, --bus-role and --log-level, and --clock /
+/// --config for programs that have a clock choice or a config file.
+void add_common_options(CommandLine& app, CommonOptions& options, bool with_clock = true,
                         bool with_config = true);
 
 /// Deletes an LCM handle opened by open_lcm(), and forgets its authenticator.
@@ -55,18 +56,6 @@ std::unique_ptr<Clock> make_clock(const std::string& kind);
 /// A SimFollowClock is fed from SIM_CLOCK. Returns a process exit code.
 int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
               const std::function<bool()>& keep_running = {});
-
-/// Exit codes of every program: 2 for a usage or input error (bad command
-/// line, configuration or scenario), which a restart cannot mend; 1 for a
-/// failure at run time (the bus cannot be opened, an unexpected exception),
-/// which a restart may.
-constexpr int kExitInputError = 2;
-constexpr int kExitRuntimeError = 1;
-
-/// Parses the command line. Returns the exit code to end with: 0 after
-/// --help, kExitInputError after a usage error (CLI11 has printed it, not
-/// its own codes); nullopt to go on.
-std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv);
 
 /// Wraps a program's main so that exceptions end the process with a clear
 /// message instead of a crash: kExitInputError for a ConfigError or an
