@@ -17,6 +17,13 @@ expect_error "^ofn_flight_monitor: error: --timeout: expected a number >= 0, got
 expect_error "^ofn_sim_runner: error: --max-time: expected a number > 0, got 'abc' (see --help)$" \
   "$BIN/ofn_sim_runner" --max-time abc
 expect_error "^ofn_vehicle_sim: error: --scenario: " "$BIN/ofn_vehicle_sim" --scenario
+# --rtf, as launch.py and fly.sh name it; --real-time-factor its other name.
+expect_error "^ofn_vehicle_sim: error: --rtf: expected a number in \[0.01, 1000\], got '0'" \
+  "$BIN/ofn_vehicle_sim" --scenario "$WORK/none.yaml" --rtf 0
+for rtf in --rtf --real-time-factor; do
+  expect_error "none.yaml" "$BIN/ofn_vehicle_sim" --scenario "$WORK/none.yaml" $rtf 2
+done
+"$BIN/ofn_vehicle_sim" --help | grep -q -- "--rtf,--real-time-factor" || fail "ofn_vehicle_sim --help lacks --rtf"
 expect_error "scenario is required\|--scenario is required" "$BIN/ofn_mission_uplink"
 cat > "$WORK/bad.yaml" <<'YAML'
 name: bad

@@ -1,6 +1,6 @@
 // vehicle_sim: the airframe, nav system and (later) LIDAR head stand-in.
-// It is the simulation's time master: its clock runs at --real-time-factor
-// times the wall clock and it publishes SIM_CLOCK for everyone else.
+// It is the simulation's time master: its clock runs at --rtf times the
+// wall clock and it publishes SIM_CLOCK for everyone else.
 
 #include <CLI/CLI.hpp>
 
@@ -18,7 +18,10 @@ int main(int argc, char** argv) {
   std::string checkpoint_path;
   ofn::add_common_options(app, options, /*with_clock=*/false);
   app.add_option("--scenario", scenario_path, "scenario file (YAML)")->required();
-  app.add_option("--real-time-factor", real_time_factor, "simulation speed, 1 = real time")
+  // --rtf as in deploy/launch.py, fly.sh and `make run RTF=`; the long
+  // name is kept for the command lines written with it.
+  app.add_option("--rtf,--real-time-factor", real_time_factor,
+                 "real-time factor: simulation speed, 1 = real time")
       ->check(ofn::number_between(0.01, 1000.0));
   app.add_option("--checkpoint", checkpoint_path,
                  "file the flight's state is saved to as it flies; when it exists at the start, "
