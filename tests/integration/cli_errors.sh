@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Bad command lines and files get a clear message and exit code 2 (an input
-# error, which the launcher never restarts), never a crash: one line
-# (services/common/include/ofn/common/command_line.hpp).
+# error, which the launcher never restarts), never a crash; and every
+# program in the build follows the command-line convention
+# (services/common/include/ofn/common/command_line.hpp): a usage error is one
+# line on stderr, --version prints the project version, --help every default.
 source "$(dirname "$0")/common.sh"
 expect_error() {  # expect_error "pattern" command...
   local pattern=$1; shift
@@ -64,8 +66,53 @@ expect_error "may be read by others" "$BIN/ofn_mapper" --bus-keys "$WORK/keys" -
 expect_error "holds no index.html" "$BIN/ofn_viewer" --web-root "$WORK"
 expect_error "lcm-netns: cannot open '$WORK/no-such-ns'" "$BIN/ofn_viewer" --port 0 --lcm-netns "$WORK/no-such-ns"
 expect_error "^ofn_viewer: error: --port: .*70000" "$BIN/ofn_viewer" --port 70000
-[[ $(wc -l < "$WORK/out.txt") -eq 1 ]] || { cat "$WORK/out.txt"; fail "ofn_viewer's usage error is not one line"; }
+
+# Every program of the build, found in it rather than listed here, so that a
+# new one cannot be forgotten. A Google Test or Google Benchmark executable
+# says so in its --help and has its framework's command line instead.
+version=$(sed -n 's/^project(.*VERSION \([0-9.]*\).*/\1/p' "$REPO/CMakeLists.txt")
+[[ $version =~ ^[0-9]+\.[0-9]+\.[0-9]+$ ]] || fail "no project version in CMakeLists.txt"
+programs=()
+for path in "$BIN"/ofn_*; do
+  [[ -f $path && -x $path ]] || continue
+  help=$(timeout 30 "$path" --help 2>&1 || true)
+  if grep -q "Google Test\|--benchmark_" <<< "$help"; then continue; fi
+  programs+=("$(basename "$path")")
+done
+(( ${#programs[@]} > 0 )) || fail "no program found in $BIN"
+# The flight's own processes must be among them: a glob gone wrong fails.
+for name in $(grep -o '{bin}/ofn_[a-z_]*' "$REPO/deploy/processes.yaml" | sed 's|{bin}/||' | sort -u) \
+    ofn_sim_runner ofn_replay ofn_baseline ofn_flight_report ofn_bus_keygen ofn_viewer; do
+  [[ " ${programs[*]} " == *" $name "* ]] || fail "$name is not among the programs found: ${programs[*]}"
+done
+for name in "${programs[@]}"; do
+  prog="$BIN/$name"
+  # A usage error: exit code 2, one line on stderr naming the problem, nothing on stdout.
+  set +e; "$prog" --no-such-option > "$WORK/out.txt" 2> "$WORK/err.txt"; code=$?; set -e
+  [[ $code -eq 2 ]] || { cat "$WORK/err.txt"; fail "$name --no-such-option exited $code, not 2"; }
+  [[ $(wc -l < "$WORK/err.txt") -eq 1 && ! -s "$WORK/out.txt" ]] ||
+    { cat "$WORK/out.txt" "$WORK/err.txt"; fail "$name: a usage error is not one line on stderr"; }
+  grep -q "^$name: error: .*--no-such-option.* (see --help)$" "$WORK/err.txt" ||
+    { cat "$WORK/err.txt"; fail "$name: the usage error does not name the option"; }
+  # --version: exit code 0, "<program> <project version>", maybe the git describe.
+  set +e; "$prog" --version > "$WORK/out.txt" 2> "$WORK/err.txt"; code=$?; set -e
+  [[ $code -eq 0 && ! -s "$WORK/err.txt" && $(wc -l < "$WORK/out.txt") -eq 1 ]] ||
+    { cat "$WORK/out.txt" "$WORK/err.txt"; fail "$name --version exited $code or is not one line"; }
+  grep -q "^$name ${version//./\\.}\( (git [^)]*)\)\?$" "$WORK/out.txt" ||
+    { cat "$WORK/out.txt"; fail "$name --version does not print version $version"; }
+  # --help: exit code 0, and every option shows its default or is required.
+  set +e; "$prog" --help > "$WORK/out.txt" 2> "$WORK/err.txt"; code=$?; set -e
+  [[ $code -eq 0 && ! -s "$WORK/err.txt" ]] || { cat "$WORK/err.txt"; fail "$name --help exited $code"; }
+  grep -q "^Usage: $name " "$WORK/out.txt" || { cat "$WORK/out.txt"; fail "$name --help: no usage line"; }
+  grep -q "(default: " "$WORK/out.txt" || { cat "$WORK/out.txt"; fail "$name --help shows no default"; }
+  # An option's entry is its line, and the next when the name column is full.
+  awk '/^  -/ { if (entry != "") print entry; entry = $0; next }
+       /^      / && entry != "" { entry = entry $0; next }
+       { if (entry != "") print entry; entry = "" }
+       END { if (entry != "") print entry }' "$WORK/out.txt" |
+    grep -v -e "^  -h,--help" -e "^  --version" | grep -v -e "(default: " -e "REQUIRED" > "$WORK/bare.txt" || true
+  [[ ! -s "$WORK/bare.txt" ]] || { cat "$WORK/bare.txt"; fail "$name --help: options without their default"; }
+done
 "$BIN/ofn_viewer" --help | grep -A1 -- "--port" | grep -q "(default: 8765)" ||
   fail "ofn_viewer --help does not show the port's default"
-[[ $("$BIN/ofn_viewer" --version) =~ ^ofn_viewer\ [0-9]+\.[0-9]+\.[0-9]+ ]] || fail "ofn_viewer --version"
-pass "bad command lines and files rejected with clear messages"
+pass "bad command lines and files rejected with clear messages; ${#programs[@]} programs follow the convention: ${programs[*]}"
