@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Benchmark campaign: every course of BENCHMARKS.md flown, compared with its baseline, reported.
 
-Usage: campaign.py [--build DIR] [--out DIR] [--courses bench1,...] [--jobs N]
+Usage: campaign.py [--bin DIR] [--out DIR] [--courses bench1,...] [--jobs N]
                    [--multiprocess COURSE|none] [--rtf X] [--quick]
 
 1. Flies every course (sim/scenarios/bench1..bench6, tree) in the lockstep
@@ -60,8 +60,8 @@ def scenario_path(course):
     return os.path.join(REPO, "sim", "scenarios", course + ".yaml")
 
 
-def bin_path(build, name):
-    return os.path.join(build, "bin", name)
+def bin_path(bin_dir, name):
+    return os.path.join(bin_dir, name)
 
 
 def timed_obstacles(scenario):
@@ -134,7 +134,7 @@ def tail(text, lines=8):
     return "\n".join((text or "").strip().splitlines()[-lines:])
 
 
-def run_lockstep(build, scenario, out_dir, config_dir=DEFAULT_CONFIG, timeout=LOCKSTEP_TIMEOUT_S,
+def run_lockstep(bin_dir, scenario, out_dir, config_dir=DEFAULT_CONFIG, timeout=LOCKSTEP_TIMEOUT_S,
                  extra_args=()):
     """Fly one scenario in the lockstep runner (`extra_args` appended to its
     command). Returns a record with the summary (None when the runner left
@@ -142,7 +142,7 @@ def run_lockstep(build, scenario, out_dir, config_dir=DEFAULT_CONFIG, timeout=LO
     if os.path.isdir(out_dir):
         shutil.rmtree(out_dir)  # a stale summary must never stand in for this flight's
     os.makedirs(out_dir)
-    cmd = [bin_path(build, "ofn_sim_runner"), "--scenario", scenario, "--config-dir", config_dir,
+    cmd = [bin_path(bin_dir, "ofn_sim_runner"), "--scenario", scenario, "--config-dir", config_dir,
            "--out", out_dir, "--quiet"] + list(extra_args)
     t0 = time.monotonic()
     rec = {"dir": out_dir, "scenario": scenario, "command": cmd, "exit_code": None, "error": None}
@@ -202,7 +202,7 @@ def process_table(config_dir, out_dir):
     return path
 
 
-def run_multiprocess(build, scenario, out_dir, rtf, config_dir=DEFAULT_CONFIG):
+def run_multiprocess(bin_dir, scenario, out_dir, rtf, config_dir=DEFAULT_CONFIG):
     """Fly one scenario through the real processes on udpm:// in a private
     network namespace (as deploy/fly.sh does, but with this build's binaries)
     and turn the recorded bus into the same report files as the runner."""
@@ -216,7 +216,7 @@ def run_multiprocess(build, scenario, out_dir, rtf, config_dir=DEFAULT_CONFIG):
     launch = [os.path.join(REPO, "deploy", "netns.sh"), "--fallback", "/usr/bin/python3",
               os.path.join(REPO, "deploy", "launch.py"), "--table", process_table(config_dir, out_dir),
               "--scenario", scenario, "--rtf", str(rtf),
-              "--bin", os.path.join(build, "bin"), "--log-dir", out_dir, "--timeout", "%.0f" % timeout]
+              "--bin", bin_dir, "--out", out_dir, "--timeout", "%.0f" % timeout]
     rec = {"dir": out_dir, "scenario": scenario, "command": launch, "exit_code": None, "error": None,
            "rtf": rtf}
     t0 = time.monotonic()
@@ -236,7 +236,7 @@ def run_multiprocess(build, scenario, out_dir, rtf, config_dir=DEFAULT_CONFIG):
     if os.path.isfile(latest):
         with open(latest) as f:
             log_path = f.read().strip()
-        report = [bin_path(build, "ofn_flight_report"), "--log", log_path, "--scenario", scenario,
+        report = [bin_path(bin_dir, "ofn_flight_report"), "--log", log_path, "--scenario", scenario,
                   "--out", out_dir]
         controller_config = os.path.join(config_dir, "controller.yaml")
         if os.path.isfile(controller_config):  # the controller flew with its defaults otherwise
@@ -262,13 +262,13 @@ def _file_digest(path):
     return h.hexdigest()
 
 
-def run_baseline(build, scenario, cache_dir, timeout=BASELINE_TIMEOUT_S):
+def run_baseline(bin_dir, scenario, cache_dir, timeout=BASELINE_TIMEOUT_S):
     """Time-optimal baseline of a scenario from ofn_baseline, cached under
     cache_dir by the scenario's content and the binary's content (a rebuilt
     planner recomputes). Returns {available, status, baseline_time, dir, ...}."""
-    exe = bin_path(build, "ofn_baseline")
+    exe = bin_path(bin_dir, "ofn_baseline")
     if not os.access(exe, os.X_OK):
-        return {"available": False, "status": "n/a", "note": "ofn_baseline is not in %s/bin" % build,
+        return {"available": False, "status": "n/a", "note": "ofn_baseline is not in %s" % bin_dir,
                 "baseline_time": None, "dir": None}
     key = _file_digest(scenario)[:16] + "-" + _file_digest(exe)[:8]
     out_dir = os.path.join(cache_dir, key)
@@ -388,7 +388,7 @@ def write_report(out, ctx):
         "- date: %s" % ctx["date"],
         "- machine: %d cores, %s" % (ctx["machine"]["cores"], ctx["machine"]["cpu"]),
         "- commit: %s" % ctx["commit"],
-        "- binaries: %s/bin, configuration %s" % (ctx["build"], ctx["config_dir"]),
+        "- binaries: %s, configuration %s" % (ctx["bin"], ctx["config_dir"]),
         "",
         cr.RECONSTRUCTION_NOTE + " Comparisons with the paper are of ratios (achieved time / "
         "time-optimal baseline), never of absolute times.",
@@ -447,7 +447,7 @@ def write_results_json(out, ctx):
                    baseline_knows_popups=r.get("baseline_knows_popups", False),
                    paper_ft2_ratio=r["paper_ratio"], figure=r.get("figure"))
         return doc
-    doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": ctx["build"],
+    doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "bin": ctx["bin"],
            "baselines_available": ctx["baselines_available"],
            "courses": [row_json(r) for r in ctx["rows"]],
            "multiprocess": row_json(ctx["mp_row"]) if ctx["mp_row"] else None,
@@ -488,8 +488,7 @@ def build_parser():
                "Exit codes: 0 when every flight passes; 1 when any fails the benchmark\n"
                "verdict (the report is written anyway); 2 for bad arguments, a missing\n"
                "build or a missing Python module (PyYAML, numpy, matplotlib).")
-    ap.add_argument("--build", default=os.path.join(REPO, "build"), metavar="DIR",
-                    help="build folder, binaries in DIR/bin (default: build)")
+    cr.add_bin_option(ap)
     ap.add_argument("--out", default=os.path.join(REPO, "results", "campaign"), metavar="DIR",
                     help="results folder (default: results/campaign)")
     ap.add_argument("--courses", metavar="NAME[,NAME]",
@@ -525,13 +524,13 @@ def parse_args(argv):
             ap.error("no scenario file %s" % cr.rel(scenario_path(c)))
     if args.jobs < 1 or not args.rtf > 0:
         ap.error("--jobs must be >= 1 and --rtf > 0")
-    args.build = os.path.abspath(args.build)
+    args.bin = cr.bin_dir(ap, args)
     args.out = os.path.abspath(args.out)
     args.config_dir = os.path.abspath(args.config_dir)
     if not os.path.isdir(args.config_dir):
         ap.error("--config-dir: no folder %s" % args.config_dir)
-    if not os.access(bin_path(args.build, "ofn_sim_runner"), os.X_OK):
-        ap.error("no ofn_sim_runner in %s/bin (build first, or pass --build)" % args.build)
+    if not os.access(bin_path(args.bin, "ofn_sim_runner"), os.X_OK):
+        ap.error("no ofn_sim_runner in %s (build first, or pass --bin)" % args.bin)
     return args
 
 
@@ -544,13 +543,13 @@ def main(argv=None):
     cache = os.path.abspath(args.baseline_cache or os.path.join(args.out, "baselines"))
     t_start = time.monotonic()
     timing = {}
-    say("campaign: %d courses in lockstep, %d at a time; binaries %s/bin; results in %s"
-        % (len(args.courses), args.jobs, args.build, args.out))
+    say("campaign: %d courses in lockstep, %d at a time; binaries %s; results in %s"
+        % (len(args.courses), args.jobs, args.bin, args.out))
 
     t0 = time.monotonic()
     load_before = os.getloadavg()[0]
     cpu_before = children_cpu_s()
-    tasks = [(c, (lambda c=c: run_lockstep(args.build, scenario_path(c), os.path.join(args.out, c), args.config_dir)))
+    tasks = [(c, (lambda c=c: run_lockstep(args.bin, scenario_path(c), os.path.join(args.out, c), args.config_dir)))
              for c in longest_first(args.courses, args.out)]
     flights = run_all(tasks, args.jobs, lambda c, rec, n: say(
         "[%d/%d] %s" % (n, len(tasks), describe(c, rec))))
@@ -565,7 +564,7 @@ def main(argv=None):
         say("multi-process: %s at %.2gx real time through the nine processes (alone; about %.0f s)"
             % (args.multiprocess, args.rtf, 80 / args.rtf))
         t0 = time.monotonic()
-        mp = run_multiprocess(args.build, scenario_path(args.multiprocess),
+        mp = run_multiprocess(args.bin, scenario_path(args.multiprocess),
                               os.path.join(args.out, "multiprocess-" + args.multiprocess), args.rtf,
                               args.config_dir)
         timing["multiprocess_s"] = time.monotonic() - t0
@@ -573,9 +572,9 @@ def main(argv=None):
 
     t0 = time.monotonic()
     needed = sorted(set(args.courses + ([args.multiprocess] if mp else [])))
-    if os.access(bin_path(args.build, "ofn_baseline"), os.X_OK):
+    if os.access(bin_path(args.bin, "ofn_baseline"), os.X_OK):
         say("baselines: %d courses with ofn_baseline (cache %s)" % (len(needed), cache))
-    baselines = run_all([(c, (lambda c=c: run_baseline(args.build, scenario_path(c), cache))) for c in needed],
+    baselines = run_all([(c, (lambda c=c: run_baseline(args.bin, scenario_path(c), cache))) for c in needed],
                         args.jobs, lambda c, b, n: say("  baseline %s: %s%s" % (
                             c, b["status"], "" if b["baseline_time"] is None else ", %.1f s" % b["baseline_time"])))
     timing["baselines_s"] = time.monotonic() - t0
@@ -606,7 +605,7 @@ def main(argv=None):
             row["figure"] = None
     timing["report_s"] = time.monotonic() - t0
     timing["total_s"] = time.monotonic() - t_start
-    ctx = {"date": now_text(), "machine": machine_info(), "commit": git_commit(), "build": args.build,
+    ctx = {"date": now_text(), "machine": machine_info(), "commit": git_commit(), "bin": args.bin,
            "config_dir": args.config_dir, "load": load,
            "jobs": args.jobs, "rows": rows, "mp_row": mp_row, "rtf": args.rtf, "timing": timing,
            "baselines_available": available,

@@ -10,17 +10,15 @@ All inputs are SI, local NED (summary.json, nav_state.csv, control_status.csv,
 scan_points.csv, baseline_trajectory.csv); figures and tables use the course
 frame (x = north, y = east, h = -down) in the display unit of summary.json.
 
-It also holds what the bench scripts' command lines share: the project
-version, one-line usage errors (exit code 2) and the third-party modules
-(PyYAML, numpy, matplotlib), which are imported only when first needed, so
-that --help and the argument checks work without them.
+The bench scripts reach the command-line helpers every Python entry point
+shares (services/tools/ofn_cli.py: the project version, one-line usage
+errors with exit code 2, --bin) through it; the third-party modules
+(PyYAML, numpy, matplotlib) are imported only when first needed, so that
+--help and the argument checks work without them.
 """
-import argparse
-import importlib
 import json
 import math
 import os
-import re
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -42,25 +40,10 @@ SMOOTHING_S = 0.5
 
 # --------------------------------------------------------------------------- command lines
 
-EXIT_USAGE = 2
-DEBIAN_PACKAGES = {"yaml": "python3-yaml", "numpy": "python3-numpy",
-                   "matplotlib": "python3-matplotlib"}
-
-
-class MissingModule(Exception):
-    """A third-party module a task needs cannot be imported; exit code 2."""
-
-
-def need(name):
-    """The module `name`, imported now; MissingModule when it cannot be."""
-    try:
-        return importlib.import_module(name)
-    except ImportError as exc:
-        missing = (getattr(exc, "name", None) or name).split(".")[0]
-        package = DEBIAN_PACKAGES.get(missing, DEBIAN_PACKAGES.get(name.split(".")[0]))
-        raise MissingModule("the Python module %s is needed but cannot be imported (%s)%s"
-                            % (missing, " ".join(str(exc).split()),
-                               "; Debian: apt-get install %s" % package if package else ""))
+# The command-line helpers every Python entry point shares
+# (services/tools/ofn_cli.py); the bench scripts reach them as cr.<name>.
+from ofn_cli import (EXIT_USAGE, ArgumentParser, InputError, MissingModule,  # noqa: E402,F401
+                     add_bin_option, bin_dir, need, project_version, run_main)
 
 
 def _plotting():
@@ -80,44 +63,6 @@ def _plotting():
 def need_plotting():
     """Fail early (MissingModule) when the figures could not be drawn."""
     _plotting()
-
-
-def project_version():
-    """The project's version, defined in one place: project(... VERSION x.y.z)
-    in the top-level CMakeLists.txt."""
-    try:
-        with open(os.path.join(REPO, "CMakeLists.txt"), encoding="utf-8") as f:
-            match = re.search(r"^\s*project\s*\([^)]*\bVERSION\s+([0-9][0-9A-Za-z.+-]*)", f.read(),
-                              re.MULTILINE | re.IGNORECASE)
-    except OSError:
-        match = None
-    return match.group(1) if match else "unknown"
-
-
-class ArgumentParser(argparse.ArgumentParser):
-    """argparse with one-line usage errors (exit code 2), the description and
-    epilog shown as written, and --version."""
-
-    def __init__(self, prog, description, epilog=None):
-        super().__init__(prog=prog, description=description, epilog=epilog,
-                         formatter_class=argparse.RawDescriptionHelpFormatter)
-        self.add_argument("--version", action="version", version="%(prog)s " + project_version())
-
-    def error(self, message):
-        self.exit(EXIT_USAGE, "%s: error: %s (see --help)\n" % (self.prog, message))
-
-
-def run_main(prog, main):
-    """sys.exit(main()), with a missing module reported in one line (exit code 2)."""
-    try:
-        code = main()
-    except MissingModule as exc:
-        sys.stderr.write("%s: error: %s\n" % (prog, exc))
-        code = EXIT_USAGE
-    except KeyboardInterrupt:
-        sys.stderr.write("%s: interrupted\n" % prog)
-        code = 130
-    sys.exit(code)
 
 
 def rel(path):

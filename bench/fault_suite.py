@@ -309,8 +309,7 @@ def build_parser():
                         help="results folder (default: results/faults-YYYYmmdd-HHMMSS)")
     parser.add_argument("--only", metavar="NAME[,NAME]", help="rows to fly, see --list (default: all)")
     parser.add_argument("--list", action="store_true", help="list the rows and exit (default: off)")
-    parser.add_argument("--bin", default=os.path.join(REPO, "build", "bin"), metavar="DIR",
-                        help="service executables (default: build/bin)")
+    cr.add_bin_option(parser, "the service executables")
     parser.add_argument("--timeout", type=float, default=300.0, metavar="S",
                         help="wall-clock limit of each flight (default: 300)")
     parser.add_argument("--open-bus", action="store_true",
@@ -336,12 +335,14 @@ def main(argv=None):
             parser.error("unknown row(s) %s; --list lists them" % ", ".join(unknown))
     if not args.rtf > 0:
         parser.error("--rtf must be > 0")
+    if not os.path.isfile(args.scenario):
+        parser.error("--scenario: no file %s" % args.scenario)
+    args.bin = cr.bin_dir(parser, args)
     if os.geteuid() != 0:
         parser.error("the hosts' network namespaces need root")
     if shutil.which("nft") is None and any(n.startswith(("loss", "blackout")) for n in names):
         parser.error("nft not found (apt-get install nftables, or make faults)")
     args.scenario = os.path.abspath(args.scenario)
-    args.bin = os.path.abspath(args.bin)
     if not args.out:
         args.out = os.path.join(REPO, "results",
                                 "faults-" + datetime.datetime.now().strftime("%Y%m%d-%H%M%S"))

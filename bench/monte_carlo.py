@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Monte Carlo over seeded random obstacle fields: success rate, clearance and time ratio.
 
-Usage: monte_carlo.py [--build DIR] [--runs N] [--seed-base S] [--jobs N] [--out DIR]
+Usage: monte_carlo.py [--bin DIR] [--runs N] [--seed-base S] [--jobs N] [--out DIR]
                       [--dense | --trap] [--wind KT] [--turbulence LEVEL]
                       [--keep-failures] [--keep-all] [--quick]
 
@@ -115,10 +115,10 @@ def rerun_commands(args, seed):
     link = "".join(" --%s %g" % (flag, value) for flag, value in
                    (("link-loss", args.link_loss), ("link-delay", args.link_delay),
                     ("link-jitter", args.link_jitter)) if value > 0)
-    one = "%s --build %s --config-dir %s%s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
-        me, args.build, args.config_dir, tpl, kind, link, seed, name)
+    one = "%s --bin %s --config-dir %s%s%s%s --seed %d --runs 1 --keep-all --out /tmp/mc-%s" % (
+        me, args.bin, args.config_dir, tpl, kind, link, seed, name)
     two = ("%s%s --seed %d%s --out /tmp/%s.yaml && %s --scenario /tmp/%s.yaml --config-dir %s%s "
-           "--out /tmp/%s" % (gen, kind, seed, tpl, name, campaign.bin_path(args.build, "ofn_sim_runner"),
+           "--out /tmp/%s" % (gen, kind, seed, tpl, name, campaign.bin_path(args.bin, "ofn_sim_runner"),
                               name, args.config_dir, " ".join([""] + runner_link_args(args, seed)),
                               name))
     return one, two
@@ -184,9 +184,9 @@ def fly_field(args, seed, template):
     obstacles = random_field.write_field(seed, field, template, args.kind, wind_kt=args.wind,
                                          turbulence=args.turbulence)
     run_dir = os.path.join(args.out, "runs", "seed-%d" % seed)
-    rec = campaign.run_lockstep(args.build, field, run_dir, args.config_dir,
+    rec = campaign.run_lockstep(args.bin, field, run_dir, args.config_dir,
                                 extra_args=runner_link_args(args, seed))
-    base = campaign.run_baseline(args.build, field, args.baseline_cache)
+    base = campaign.run_baseline(args.bin, field, args.baseline_cache)
     s = rec.get("summary") or {}
     rs = s.get("clearance_required")
     unit, k = cr.unit_scale(s)
@@ -309,7 +309,7 @@ def write_report(args, runs, ctx):
         "- date: %s" % ctx["date"],
         "- machine: %d cores, %s" % (ctx["machine"]["cores"], ctx["machine"]["cpu"]),
         "- commit: %s" % ctx["commit"],
-        "- binaries: %s/bin, configuration %s" % (args.build, args.config_dir),
+        "- binaries: %s, configuration %s" % (args.bin, args.config_dir),
         "- fields: seeds %s (bench/random_field.py%s, course from %s), %d flown %d at a time"
         % (seeds_text(args.seeds),
            KIND_FLAGS[args.kind] + random_field.weather_flags(args.wind, args.turbulence),
@@ -332,7 +332,7 @@ def write_report(args, runs, ctx):
         "|---|---|",
         "| outcomes | %s |" % ", ".join("%s %d" % (o.replace("_", " "), outcomes[o]) for o in OUTCOMES),
     ]
-    doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "build": args.build,
+    doc = {"date": ctx["date"], "machine": ctx["machine"], "commit": ctx["commit"], "bin": args.bin,
            "mode": args.kind, "runs": n, "outcomes": outcomes,
            "baselines_available": have_baseline, "wall_s": ctx["wall_s"], "load_average": ctx["load"],
            "seed_base": args.seed_base, "seeds": args.seeds, "link_loss": args.link_loss,
@@ -481,8 +481,7 @@ def build_parser():
                "1 when any field fails; 2 for bad arguments, a missing build or a missing\n"
                "Python module (PyYAML, numpy, matplotlib).  The report is written either way."
                % (100 * SUCCESS_GOAL))
-    ap.add_argument("--build", default=os.path.join(REPO, "build"), metavar="DIR",
-                    help="build folder, binaries in DIR/bin (default: build)")
+    cr.add_bin_option(ap)
     ap.add_argument("--runs", type=int, default=None, metavar="N",
                     help="number of fields (default: %d; with --quick %d)" % (DEFAULT_RUNS, QUICK_RUNS))
     ap.add_argument("--seed-base", "--seed", dest="seed_base", type=int, default=1, metavar="S",
@@ -552,7 +551,7 @@ def parse_args(argv):
             ap.error("%s: expected 0 to 10 s, got %g" % (flag, value))
     if args.seeds is None:
         args.seeds = list(range(args.seed_base, args.seed_base + args.runs))
-    args.build = os.path.abspath(args.build)
+    args.bin = cr.bin_dir(ap, args)
     args.out = os.path.abspath(args.out)
     args.config_dir = os.path.abspath(args.config_dir)
     args.baseline_cache = os.path.abspath(args.baseline_cache or os.path.join(args.out, "baselines"))
@@ -560,8 +559,8 @@ def parse_args(argv):
         ap.error("--template: no file %s" % args.template)
     if not os.path.isdir(args.config_dir):
         ap.error("--config-dir: no folder %s" % args.config_dir)
-    if not os.access(campaign.bin_path(args.build, "ofn_sim_runner"), os.X_OK):
-        ap.error("no ofn_sim_runner in %s/bin (build first, or pass --build)" % args.build)
+    if not os.access(campaign.bin_path(args.bin, "ofn_sim_runner"), os.X_OK):
+        ap.error("no ofn_sim_runner in %s (build first, or pass --bin)" % args.bin)
     return args
 
 
@@ -581,10 +580,10 @@ def main(argv=None):
             shutil.rmtree(path)  # results of an earlier campaign must not mix in
         os.makedirs(path, exist_ok=True)
     seeds = args.seeds
-    print("monte_carlo: %d fields (seeds %s), %d at a time; binaries %s/bin; results in %s"
-          % (len(seeds), seeds_text(seeds), args.jobs, args.build, args.out), flush=True)
-    if not os.access(campaign.bin_path(args.build, "ofn_baseline"), os.X_OK):
-        print("monte_carlo: no ofn_baseline in %s/bin: baselines and ratios will read n/a" % args.build,
+    print("monte_carlo: %d fields (seeds %s), %d at a time; binaries %s; results in %s"
+          % (len(seeds), seeds_text(seeds), args.jobs, args.bin, args.out), flush=True)
+    if not os.access(campaign.bin_path(args.bin, "ofn_baseline"), os.X_OK):
+        print("monte_carlo: no ofn_baseline in %s: baselines and ratios will read n/a" % args.bin,
               flush=True)
     load_before = os.getloadavg()[0]
     progress = Progress(len(seeds))

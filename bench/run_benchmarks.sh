@@ -49,9 +49,9 @@ done
 
 echo
 echo "== benchmark campaign: seven courses in lockstep, bench3 through the processes (results/campaign) =="
-/usr/bin/python3 "$repo/bench/campaign.py" --build "$build" || echo "(campaign: not every goal met, see results/campaign/report.md)"
+/usr/bin/python3 "$repo/bench/campaign.py" --bin "$build/bin" || echo "(campaign: not every goal met, see results/campaign/report.md)"
 
 echo
 echo "== Monte Carlo: ${MC_RUNS:-300} random fields in lockstep (results/monte_carlo; MC_RUNS=N to change) =="
-/usr/bin/python3 "$repo/bench/monte_carlo.py" --build "$build" --runs "${MC_RUNS:-300}" ||
+/usr/bin/python3 "$repo/bench/monte_carlo.py" --bin "$build/bin" --runs "${MC_RUNS:-300}" ||
   echo "(Monte Carlo: success below the 99 % goal, see results/monte_carlo/report.md)"

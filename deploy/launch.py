@@ -31,10 +31,11 @@ failed) or every service stopped without an ends_run process.
 
 Only the Python standard library and PyYAML are used so that the launcher
 runs unchanged on the onboard computers (Debian: python3-yaml).  PyYAML is
-imported when first needed, so --help and --version work without it.
+imported when first needed, so --help and --version work without it; the
+command-line helpers are those every Python entry point shares
+(services/tools/ofn_cli.py, in the same checkout).
 """
 
-import argparse
 import datetime
 import os
 import re
@@ -47,6 +48,8 @@ import threading
 import time
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(REPO_ROOT, "services", "tools"))
+import ofn_cli  # noqa: E402
 DEFAULT_TABLE = os.path.join(REPO_ROOT, "deploy", "processes.yaml")
 DEFAULT_BIN = os.path.join(REPO_ROOT, "build", "bin")
 DEFAULT_LOG_DIR = os.path.join(REPO_ROOT, "results")
@@ -105,29 +108,16 @@ REQUIRED_FIELDS = {"name": str, "host": str, "core": int, "command": list}
 OPTIONAL_FIELDS = {"config": str, "restart": bool, "ends_run": bool, "priority": int}
 
 
-class TableError(Exception):
+class TableError(ofn_cli.InputError):
     """Invalid process table or launch input; reported with exit code 2."""
-
-
-def project_version():
-    """The project's version: project(... VERSION x.y.z) in the top-level
-    CMakeLists.txt, the one place it is defined."""
-    try:
-        with open(os.path.join(REPO_ROOT, "CMakeLists.txt"), encoding="utf-8") as f:
-            match = re.search(r"^\s*project\s*\([^)]*\bVERSION\s+([0-9][0-9A-Za-z.+-]*)", f.read(),
-                              re.MULTILINE | re.IGNORECASE)
-    except OSError:
-        match = None
-    return match.group(1) if match else "unknown"
 
 
 def _yaml():
     """PyYAML, imported on first use."""
     try:
-        import yaml
-    except ImportError:
-        raise TableError("PyYAML is missing: apt-get install python3-yaml")
-    return yaml
+        return ofn_cli.need("yaml")
+    except ofn_cli.MissingModule as e:
+        raise TableError(str(e))
 
 
 def _yaml_error_text(error):
@@ -782,17 +772,10 @@ class RunState:
 # Command line and main
 # ---------------------------------------------------------------------------
 
-class OneLineErrorParser(argparse.ArgumentParser):
-    """argparse whose usage errors are one line (exit code 2)."""
-
-    def error(self, message):
-        self.exit(EXIT_BAD_INPUT, "%s: error: %s (see --help)\n" % (self.prog, message))
-
-
 def build_parser():
-    parser = OneLineErrorParser(
-        prog="deploy/launch.py",
-        description="Start, supervise and record the flight-software services of one run.",
+    parser = ofn_cli.ArgumentParser(
+        "deploy/launch.py",
+        "Start, supervise and record the flight-software services of one run.",
         epilog="Examples:\n"
                "  deploy/launch.py --scenario sim/scenarios/bench3.yaml\n"
                "  deploy/launch.py --scenario sim/scenarios/bench3.yaml --only mapper,global_planner \\\n"
@@ -803,9 +786,7 @@ def build_parser():
                "\n"
                "Exit codes: the ends_run process's; 2 for bad input or a service that exits with\n"
                "code 2 (its configuration or usage error; never restarted); 3 when --timeout\n"
-               "ends the run; 128+N on signal N; 1 when the launcher itself fails.",
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--version", action="version", version="%(prog)s " + project_version())
+               "ends the run; 128+N on signal N; 1 when the launcher itself fails.")
     parser.add_argument("--table", default=DEFAULT_TABLE, metavar="FILE",
                         help="process table (default: deploy/processes.yaml)")
     parser.add_argument("--scenario", required=True, metavar="FILE",
@@ -1232,4 +1213,4 @@ def print_summary(services, console, max_restarts, resources=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    ofn_cli.run_main("launch.py", main)

@@ -15,12 +15,20 @@ Exit codes: 0 done; 1 when the log holds no decodable message on the channel;
 2 for bad arguments, an unreadable file or missing types.
 """
 
-import argparse
 import io
 import json
 import math
+import os
 import struct
 import sys
+
+# The command-line helpers of the project's Python programs (--version,
+# one-line usage errors with exit code 2), from the same checkout.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                "services", "tools"))
+from ofn_cli import ArgumentParser, run_main  # noqa: E402
+
+PROG = "examples/python/nav_track.py"
 
 # An LCM log is a sequence of events, each: sync word 0xEDA1DA01, int64 event
 # number, int64 timestamp (microseconds), int32 channel length, int32 data
@@ -106,33 +114,46 @@ def summarise(path, channel, nav_state_t):
     }
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(
-        description="First and last positions and top speed of the NAV_STATE track in an LCM log, "
-                    "decoded with ofn's generated Python types (no python3-lcm needed).")
-    parser.add_argument("log", help="LCM log file, e.g. a flight's flight.lcm")
-    parser.add_argument("--channel", default="NAV_STATE", help="channel of ofn.nav_state_t (default: %(default)s)")
+def build_parser():
+    parser = ArgumentParser(
+        PROG,
+        "First and last positions and top speed of the NAV_STATE track in an LCM log,\n"
+        "decoded with ofn's generated Python types (no python3-lcm needed).",
+        epilog="Examples:\n"
+               "  PYTHONPATH=<prefix>/share/ofn/python /usr/bin/python3 examples/python/nav_track.py flight.lcm\n"
+               "  /usr/bin/python3 examples/python/nav_track.py --types build/lcmtypes/python flight.lcm\n"
+               "\n"
+               "Exit codes: 0 done; 1 when the log holds no decodable message on the channel;\n"
+               "2 for bad arguments, an unreadable file or missing types.")
+    parser.add_argument("log", metavar="LOG", help="LCM log file, e.g. a flight's flight.lcm (required)")
+    parser.add_argument("--channel", default="NAV_STATE",
+                        help="channel of ofn.nav_state_t (default: %(default)s)")
     parser.add_argument("--types", metavar="DIR",
-                        help="folder holding the generated package ofn/ (default: from PYTHONPATH), "
-                             "e.g. <prefix>/share/ofn/python or build/lcmtypes/python")
-    parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
-    args = parser.parse_args(argv)
+                        help="folder holding the generated package ofn/, e.g. "
+                             "<prefix>/share/ofn/python or build/lcmtypes/python (default: from PYTHONPATH)")
+    parser.add_argument("--json", action="store_true",
+                        help="print the summary as one JSON object (default: text)")
+    return parser
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
 
     if args.types:
         sys.path.insert(0, args.types)
     try:
         from ofn import nav_state_t
     except ImportError as error:
-        print(f"nav_track.py: error: ofn's Python types not found ({error}): pass --types "
+        print(f"{PROG}: error: ofn's Python types not found ({error}): pass --types "
               "<prefix>/share/ofn/python or set PYTHONPATH", file=sys.stderr)
         return 2
     try:
         summary = summarise(args.log, args.channel, nav_state_t)
     except OSError as error:
-        print(f"nav_track.py: error: cannot read {args.log}: {error.strerror}", file=sys.stderr)
+        print(f"{PROG}: error: cannot read {args.log}: {error.strerror}", file=sys.stderr)
         return 2
     if summary is None:
-        print(f"nav_track.py: no decodable {args.channel} message in {args.log}", file=sys.stderr)
+        print(f"{PROG}: no decodable {args.channel} message in {args.log}", file=sys.stderr)
         return 1
 
     if args.json:
@@ -153,4 +174,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_main(PROG, main)

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Draw the flight-test figure of an obstacle-avoidance flight from a results folder.
 
 Usage: plot_flight.py RESULTS_DIR [--out RESULTS_DIR/flight.png] [--scenario FILE] [--no-lidar]
@@ -8,16 +8,22 @@ actual against the reference, the reference against its limit, the
 controller's pseudo-control against its bound) and tracking.png (position
 error), and prints the paths written. All inputs are SI, local NED; the
 plots use the course frame (x = north, y = east, h = -down) in the display
-unit named by summary.json. The CSV headers name no unit; a header that
-does (``north [m]``) is read as the bare name.
+unit named by summary.json. Each CSV header names its column's unit, as
+ofn_flight_report writes them (``north [m]``); a column is read by its bare
+name (``north``), so a header without the unit reads the same.
 
 Command traces (reference acceleration, pseudo-control, tracking error)
 show only the samples in which the controller flies a plan, as the
 summary's figures count them: nothing of the hold before the mission
 (CONTROL_STATUS mode HOLD), a stale navigation solution or the hold after
 arrival (NAV_STALE, DONE).
+
+numpy and matplotlib are imported once the command line has been read
+(when run) or on import (as a module, bench/campaign_report.py), so that
+--help, --version and a bad command line need neither. A missing module,
+a missing or unreadable input and a figure that cannot be written are
+one-line errors with exit code 2.
 """
-import argparse
 import csv
 import json
 import math
@@ -25,12 +31,30 @@ import os
 import re
 import sys
 
-import matplotlib
-matplotlib.use("Agg")  # headless: runs on test machines and in CI
-import matplotlib.pyplot as plt  # noqa: E402
-import matplotlib.transforms as mtransforms  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.patches import Circle, Polygon, Rectangle  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ofn_cli import ArgumentParser, InputError, need, run_main  # noqa: E402
+
+PROG = "services/tools/plot_flight.py"
+
+# Set by import_plotting(): matplotlib (the Agg backend) and numpy.
+np = plt = mtransforms = Circle = Polygon = Rectangle = None
+
+
+def import_plotting():
+    """numpy and matplotlib, headless (Agg: runs on test machines and in CI);
+    MissingModule (one line, exit code 2) when either cannot be imported."""
+    global np, plt, mtransforms, Circle, Polygon, Rectangle
+    if plt is None:
+        np = need("numpy")
+        need("matplotlib").use("Agg")
+        plt = need("matplotlib.pyplot")
+        mtransforms = need("matplotlib.transforms")
+        patches = need("matplotlib.patches")
+        Circle, Polygon, Rectangle = patches.Circle, patches.Polygon, patches.Rectangle
+
+
+if __name__ != "__main__":
+    import_plotting()  # a module: its functions are used at once
 
 REQUIRED = ("nav_state.csv", "control_status.csv", "waypoints.csv")
 FOOTER = "course geometry: this project's reconstruction of the benchmark"
@@ -50,8 +74,8 @@ FRAME_MARGIN = 0.06  # share of the larger extent added round the top view's fra
 
 
 def fail(msg):
-    print("plot_flight: error: " + msg, file=sys.stderr)
-    sys.exit(2)
+    """A missing or unusable input: one line, exit code 2 (run_main)."""
+    raise InputError(msg)
 
 
 def column_name(header):
@@ -282,9 +306,14 @@ def subsample(data, limit):
 
 def read_ground_altitude(scenario_path):
     """environment.ground_altitude of a scenario file, metres (0 when absent)."""
-    import yaml  # python3-yaml; only needed with --scenario
+    yaml = need("yaml")  # python3-yaml; only needed with --scenario
     with open(scenario_path) as f:
-        doc = yaml.safe_load(f) or {}
+        try:
+            doc = yaml.safe_load(f) or {}
+        except yaml.YAMLError as exc:
+            raise ValueError("not valid YAML: " + " ".join(str(exc).split()))
+    if not isinstance(doc, dict):
+        raise ValueError("not a scenario (a YAML mapping)")
     per_unit = 0.3048 if doc.get("units") == "ft" else 1.0
     return float((doc.get("environment") or {}).get("ground_altitude", 0.0) or 0.0) * per_unit
 
@@ -650,8 +679,10 @@ def load_results(res, scenario=None):
     if scenario:
         try:
             ground = read_ground_altitude(scenario)
-        except (OSError, ValueError, ImportError) as exc:
-            fail("cannot read the ground altitude of %s: %s" % (scenario, exc))
+        except OSError as exc:
+            fail("--scenario: cannot read %s: %s" % (scenario, exc.strerror))
+        except (ValueError, TypeError, AttributeError) as exc:
+            fail("--scenario: cannot read the ground altitude of %s: %s" % (scenario, exc))
     return dict(summary=summary, nav=nav, ctl=ctl, wps=wps, ground_altitude=ground,
                 gpath=load_csv(res, "global_path.csv", False),
                 ref=load_csv(res, "ref_traj.csv", False),
@@ -728,36 +759,64 @@ def flight_figure(data, lidar=True):
     return fig
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("results_dir")
-    ap.add_argument("--out", help="flight figure path (default RESULTS_DIR/flight.png)")
-    ap.add_argument("--scenario", help="the flight's scenario file, for the ground altitude of "
-                    "the clearance (default: the ground at altitude 0)")
-    ap.add_argument("--no-lidar", action="store_true", help="leave the LIDAR hits out")
-    args = ap.parse_args()
+def build_parser():
+    ap = ArgumentParser(PROG, __doc__.splitlines()[0],
+                        epilog="Example:\n"
+                               "  /usr/bin/python3 services/tools/plot_flight.py results/lockstep\n"
+                               "\n"
+                               "Exit codes: 0 when the figures are written; 2 for a bad command line,\n"
+                               "a missing or unreadable input, a figure that cannot be written or a\n"
+                               "missing Python module (numpy, matplotlib; PyYAML with --scenario).")
+    ap.add_argument("results_dir", metavar="RESULTS_DIR",
+                    help="folder written by ofn_flight_report or ofn_sim_runner --out (required)")
+    ap.add_argument("--out", metavar="FILE",
+                    help="flight figure path; tracking.png goes beside it "
+                         "(default: RESULTS_DIR/flight.png)")
+    ap.add_argument("--scenario", metavar="FILE",
+                    help="the flight's scenario file, for the ground altitude of the clearance "
+                         "(default: the ground at altitude 0)")
+    ap.add_argument("--no-lidar", action="store_true",
+                    help="leave the LIDAR hits out (default: drawn)")
+    return ap
+
+
+def save(fig, path, dpi):
+    try:
+        fig.savefig(path, dpi=dpi)
+    except OSError as exc:
+        fail("cannot write %s: %s" % (path, exc.strerror or exc))
+    finally:
+        plt.close(fig)
+    print(path)
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
     res = args.results_dir
     if not os.path.isdir(res):
         fail("results folder not found: " + res)
+    if args.scenario is not None and not os.path.isfile(args.scenario):
+        fail("--scenario: no file " + args.scenario)
+    import_plotting()
     out = args.out or os.path.join(res, "flight.png")
     data = load_results(res, args.scenario)
 
     fig = flight_figure(data, lidar=not args.no_lidar)
-    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    print(out)
+    out_dir = os.path.dirname(os.path.abspath(out))
+    try:
+        os.makedirs(out_dir, exist_ok=True)
+    except OSError as exc:
+        fail("--out: cannot create %s: %s" % (out_dir, exc.strerror or exc))
+    save(fig, out, 110)
 
     summary = data["summary"]
     k = 1.0 / float(summary.get("metres_per_unit") or 1.0)
     head, _ = verdict_title(summary, data["name"])
-    track = os.path.join(os.path.dirname(os.path.abspath(out)), "tracking.png")
-    fig = tracking_figure(k, summary.get("display_unit", "m"), data["nav"], data["ctl"], head)
-    fig.savefig(track, dpi=120)
-    plt.close(fig)
-    print(track)
+    track = os.path.join(out_dir, "tracking.png")
+    save(tracking_figure(k, summary.get("display_unit", "m"), data["nav"], data["ctl"], head),
+         track, 120)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_main(PROG, main)

@@ -1,11 +1,20 @@
-"""Command lines of the deploy and bench scripts: help, usage errors, versions,
-and `deploy/replay.sh latest` after a flight flown by deploy/fly.sh.
+"""Command lines of the deploy scripts and of every Python program: help,
+usage errors, versions, defaults in the help, and `deploy/replay.sh latest`
+after a flight flown by deploy/fly.sh.
+
+Every Python entry point of the repository (a .py file outside tests/ with
+a `__main__` block, found by walking the tree, so that a new one cannot be
+left out) must answer --help and --version without numpy, matplotlib or
+PyYAML, show every option's default, and turn an unknown option, a missing
+or bad input file and a missing module into one line with exit code 2; its
+bad inputs are listed in PythonEntryPointTest.bad_inputs, which must name
+every entry point found.
 
 Needs no build, no network and no LCM: flights use a small process table of
 shell commands, and lcm-logger, lcm-logplayer, ofn_flight_report and
 plot_flight.py are replaced by stand-ins in a scratch copy of the
-repository.  The bench scripts' third-party modules are hidden by stub
-packages that fail to import.
+repository.  Third-party modules are hidden by stub packages that fail to
+import.
 
 Run from the repository root:
     /usr/bin/python3 -m unittest tests/integration/test_cli_usage.py
@@ -46,6 +55,38 @@ def write_executable(path, text):
         f.write(textwrap.dedent(text))
     os.chmod(path, os.stat(path).st_mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
     return path
+
+
+def python_entry_points():
+    """Every Python program of the repository, as paths relative to it: a
+    .py file outside tests/ with an `if __name__ == "__main__":` block.
+    Build trees (a folder holding CMakeCache.txt), results/ and hidden
+    folders are not searched."""
+    found = []
+    for root, dirs, files in os.walk(REPO_ROOT):
+        top = os.path.samefile(root, REPO_ROOT)
+        dirs[:] = sorted(d for d in dirs
+                         if not d.startswith(".") and d != "__pycache__"
+                         and not (top and d in ("tests", "results"))
+                         and not os.path.isfile(os.path.join(root, d, "CMakeCache.txt")))
+        for name in sorted(files):
+            if not name.endswith(".py"):
+                continue
+            path = os.path.join(root, name)
+            with open(path, encoding="utf-8") as f:
+                if re.search(r"^if __name__ == .__main__.:", f.read(), re.MULTILINE):
+                    found.append(os.path.relpath(path, REPO_ROOT))
+    return found
+
+
+def hide_modules(folder, names=HIDDEN_MODULES):
+    """Stub packages in `folder` that fail to import as the missing module
+    would; put `folder` first on PYTHONPATH to hide the real ones."""
+    for name in names:
+        os.makedirs(os.path.join(folder, name))
+        with open(os.path.join(folder, name, "__init__.py"), "w") as f:
+            f.write("raise ModuleNotFoundError(\"No module named '%s'\", name=%r)\n" % (name, name))
+    return dict(os.environ, PYTHONPATH=folder)
 
 
 class ScratchTestCase(unittest.TestCase):
@@ -198,6 +239,8 @@ class FlyThenReplayTest(ScratchTestCase):
             os.makedirs(os.path.join(self.repo, sub))
         for name in ("fly.sh", "flight_common.sh", "launch.py", "netns.sh", "replay.sh"):
             shutil.copy2(os.path.join(DEPLOY, name), os.path.join(self.repo, "deploy", name))
+        shutil.copy2(os.path.join(REPO_ROOT, "services", "tools", "ofn_cli.py"),
+                     os.path.join(self.repo, "services", "tools", "ofn_cli.py"))
         with open(os.path.join(self.repo, "sim/scenarios/bench3.yaml"), "w") as f:
             f.write("name: stand-in\n")
         open(os.path.join(self.repo, "config/controller.yaml"), "w").close()
@@ -298,16 +341,12 @@ class BenchScriptTest(ScratchTestCase):
     def setUp(self):
         super().setUp()
         # Stub packages that fail to import, first on the module path.
-        self.stubs = os.path.join(self.dir, "stubs")
-        for name in HIDDEN_MODULES:
-            os.makedirs(os.path.join(self.stubs, name))
-            with open(os.path.join(self.stubs, name, "__init__.py"), "w") as f:
-                f.write("raise ModuleNotFoundError(\"No module named '%s'\", name=%r)\n" % (name, name))
-        self.no_modules = dict(os.environ, PYTHONPATH=self.stubs)
+        self.no_modules = hide_modules(os.path.join(self.dir, "stubs"))
         # A build with an ofn_sim_runner that is never run.
         self.build = os.path.join(self.dir, "build")
-        os.makedirs(os.path.join(self.build, "bin"))
-        write_executable(os.path.join(self.build, "bin", "ofn_sim_runner"), "#!/bin/sh\nexit 1\n")
+        self.bin = os.path.join(self.build, "bin")
+        os.makedirs(self.bin)
+        write_executable(os.path.join(self.bin, "ofn_sim_runner"), "#!/bin/sh\nexit 1\n")
 
     def bench(self, script, *args, env=None):
         return run([sys.executable, os.path.join(BENCH, script)] + list(args), env=env)
@@ -316,16 +355,6 @@ class BenchScriptTest(ScratchTestCase):
         for name in HIDDEN_MODULES:
             result = run([sys.executable, "-c", "import %s" % name], env=self.no_modules)
             self.assertNotEqual(result.returncode, 0, name)
-
-    def test_help_and_version_without_numpy_matplotlib_yaml(self):
-        version = project_version()
-        for script in BENCH_SCRIPTS:
-            result = self.bench(script, "--help", env=self.no_modules)
-            self.assertEqual(result.returncode, 0, script + ": " + result.stderr)
-            self.assertTrue(result.stdout.startswith("usage: bench/" + script), result.stdout)
-            result = self.bench(script, "--version", env=self.no_modules)
-            self.assertEqual(result.returncode, 0, script + ": " + result.stderr)
-            self.assertEqual(result.stdout.strip(), "bench/%s %s" % (script, version))
 
     def test_missing_module_at_use_time_is_one_line(self):
         out = os.path.join(self.dir, "out")
@@ -341,11 +370,12 @@ class BenchScriptTest(ScratchTestCase):
             f.write("t,north,east,down\n0,0,0,0\n")
         result = self.bench("campaign_report.py", results_dir, env=self.no_modules)
         self.assert_one_line_error(result, 2, "numpy", "python3-numpy")
-        # Checked before any flight, not after hours of them.
+        # Checked before any flight, not after hours of them; --build DIR (the
+        # old spelling of --bin DIR/bin) finds the same programs.
         for script in ("monte_carlo.py", "campaign.py"):
-            result = self.bench(script, "--build", self.build, "--out", out, "--quick",
-                                env=self.no_modules)
-            self.assert_one_line_error(result, 2, "bench/%s: error:" % script, "apt-get install")
+            for programs in (["--bin", self.bin], ["--build", self.build]):
+                result = self.bench(script, *programs, "--out", out, "--quick", env=self.no_modules)
+                self.assert_one_line_error(result, 2, "bench/%s: error:" % script, "apt-get install")
         self.assertFalse(os.path.exists(out), "work was started")
 
     def test_usage_and_input_errors_are_one_line(self):
@@ -357,14 +387,17 @@ class BenchScriptTest(ScratchTestCase):
             f.write("- 1\n")
         out = os.path.join(self.dir, "f.yaml")
         cases = [
-            ("monte_carlo.py", ["--build", self.build, "--runs", "0"], "--runs and --jobs must be >= 1"),
-            ("monte_carlo.py", ["--build", self.build, "--seeds", "1,x"], "--seeds"),
-            ("monte_carlo.py", ["--build", os.path.join(self.dir, "none")], "no ofn_sim_runner"),
-            ("monte_carlo.py", ["--build", self.build, "--template", broken + ".missing"], "--template"),
-            ("monte_carlo.py", ["--build", self.build, "--config-dir", self.dir + "/none"], "--config-dir"),
+            ("monte_carlo.py", ["--bin", self.bin, "--runs", "0"], "--runs and --jobs must be >= 1"),
+            ("monte_carlo.py", ["--bin", self.bin, "--seeds", "1,x"], "--seeds"),
+            ("monte_carlo.py", ["--bin", os.path.join(self.dir, "none")], "no ofn_sim_runner"),
+            # --build DIR, the old spelling of --bin DIR/bin, still works, but not with --bin.
+            ("campaign.py", ["--build", os.path.join(self.dir, "none")], "no ofn_sim_runner in %s/none/bin" % self.dir),
+            ("campaign.py", ["--build", self.build, "--bin", self.bin], "old spelling of --bin"),
+            ("monte_carlo.py", ["--bin", self.bin, "--template", broken + ".missing"], "--template"),
+            ("monte_carlo.py", ["--bin", self.bin, "--config-dir", self.dir + "/none"], "--config-dir"),
             ("monte_carlo.py", ["--jobs"], "expected one argument"),
-            ("campaign.py", ["--build", self.build, "--courses", "bench9"], "no scenario file"),
-            ("campaign.py", ["--build", self.build, "--rtf", "0"], "--rtf > 0"),
+            ("campaign.py", ["--bin", self.bin, "--courses", "bench9"], "no scenario file"),
+            ("campaign.py", ["--bin", self.bin, "--rtf", "0"], "--rtf > 0"),
             ("campaign.py", ["--fast"], "unrecognized arguments: --fast"),
             ("random_field.py", [], "required"),
             ("random_field.py", ["--seed", "one", "--out", out], "invalid int value"),
@@ -375,7 +408,7 @@ class BenchScriptTest(ScratchTestCase):
             ("random_field.py", ["--seed", "1", "--out", os.path.join(listed, "f.yaml")], "list.yaml"),
             ("random_field.py", ["--seed", "1", "--out", out, "--dense", "--trap"],
              "--trap: not allowed with argument --dense"),
-            ("monte_carlo.py", ["--build", self.build, "--trap", "--dense"],
+            ("monte_carlo.py", ["--bin", self.bin, "--trap", "--dense"],
              "--dense: not allowed with argument --trap"),
             ("campaign_report.py", [], "required"),
             ("campaign_report.py", [os.path.join(self.dir, "none")], "no folder"),
@@ -387,22 +420,170 @@ class BenchScriptTest(ScratchTestCase):
                 self.assert_one_line_error(result, 2, "bench/%s: error:" % script, fragment)
                 self.assertEqual(result.stdout, "")
 
-    def test_help_shows_every_default(self):
-        for script in BENCH_SCRIPTS:
-            module = load_module(os.path.join(BENCH, script))
-            for action in module.build_parser()._actions:
-                if action.dest in ("help", "version"):
-                    continue
-                with self.subTest(script=script, option=action.option_strings or action.dest):
-                    self.assertRegex(action.help or "", r"\((default: [^)]+|required)\)$")
-
 
 def load_module(path):
-    name = "ofn_cli_" + os.path.splitext(os.path.basename(path))[0]
+    name = "entry_" + os.path.splitext(os.path.basename(path))[0]
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+# ---------------------------------------------------------------------------
+# Every Python entry point
+# ---------------------------------------------------------------------------
+
+SWEEP_HEADER = ("mass_scale,airframe,wind [kt],turbulence,adaptive_rms [m],adaptive_max [m],"
+                "baseline_rms [m],baseline_max [m]\n")
+
+
+class PythonEntryPointTest(ScratchTestCase):
+    def setUp(self):
+        super().setUp()
+        self.entry_points = python_entry_points()
+        self.no_modules = hide_modules(os.path.join(self.dir, "stubs"))
+        self.plain_env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+
+    def write(self, name, text):
+        path = os.path.join(self.dir, name)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w") as f:
+            f.write(textwrap.dedent(text))
+        return path
+
+    def bad_inputs(self):
+        """{entry point: [(arguments, what the one-line error says, hide the
+        third-party modules)]}: a missing file, a bad file, a missing module."""
+        d = self.dir
+        missing = os.path.join(d, "none")
+        empty_dir = os.path.join(d, "empty")
+        os.makedirs(empty_dir)
+        broken = self.write("broken.yaml", "units: ft\nstart: [1, 2\n")
+        results = os.path.join(d, "results")
+        for name, text in (("summary.json", "{}\n"), ("nav_state.csv", "t [s],north [m]\n"),
+                           ("control_status.csv", "t [s],mode\n"), ("waypoints.csv", "t [s]\n")):
+            self.write(os.path.join("results", name), text)
+        self.write("unreadable/summary.json", "{not json\n")
+        sweep = self.write("sweep.csv", SWEEP_HEADER + '1.2,"nominal",10,light,0.5,1.1,0.9,2.0\n')
+        wrong_sweep = self.write("wrong.csv", "a,b\n1,2\n")
+        bad_number = self.write("bad.csv", SWEEP_HEADER + '1.2,"nominal",ten,light,0.5,1.1,0.9,2.0\n')
+        bin_dir = os.path.join(d, "bin")
+        os.makedirs(bin_dir)
+        write_executable(os.path.join(bin_dir, "ofn_sim_runner"), "#!/bin/sh\nexit 1\n")
+        types = os.path.join(d, "types")
+        self.write("types/ofn/__init__.py", "class nav_state_t:\n    pass\n")
+        log = self.write("flight.lcm", "not a log\n")
+        scenario = os.path.join(REPO_ROOT, "sim", "scenarios", "open.yaml")
+        field = os.path.join(d, "field.yaml")
+        return {
+            "bench/campaign.py": [
+                (["--bin", missing], "no ofn_sim_runner in " + missing, False),
+                (["--bin", bin_dir, "--config-dir", missing], "--config-dir", False),
+                (["--bin", bin_dir, "--quick", "--out", missing], "python3-yaml", True),
+            ],
+            "bench/campaign_report.py": [
+                ([missing], "no folder", False),
+                ([empty_dir], "no summary.json", False),
+                ([results], "python3-numpy", True),
+            ],
+            "bench/fault_suite.py": [
+                (["--scenario", missing], "--scenario: no file", False),
+                (["--only", "no-such-row"], "unknown row", False),
+                (["--list"], "python3-yaml", True),
+            ],
+            "bench/monte_carlo.py": [
+                (["--bin", missing], "no ofn_sim_runner", False),
+                (["--bin", bin_dir, "--template", missing], "--template", False),
+                (["--bin", bin_dir, "--quick", "--out", missing], "python3-yaml", True),
+            ],
+            "bench/plot_tracking_sweep.py": [
+                ([missing], "cannot read " + missing, False),
+                ([wrong_sweep], "has no column mass_scale", False),
+                ([bad_number], "line 2: wind is 'ten', not a number", False),
+                ([sweep, os.path.join(missing, "sweep.png")], "cannot write", False),
+                ([sweep], "python3-matplotlib", True),
+            ],
+            "bench/random_field.py": [
+                (["--seed", "1", "--out", field, "--template", missing], "No such file", False),
+                (["--seed", "1", "--out", field, "--template", broken], "not valid YAML", False),
+                (["--seed", "1", "--out", field], "python3-yaml", True),
+            ],
+            "deploy/launch.py": [
+                (["--scenario", missing], "not found", False),
+                (["--scenario", broken], "not valid YAML: line 3", False),
+                (["--scenario", scenario, "--table", missing], "process table not found", False),
+                (["--scenario", scenario], "python3-yaml", True),
+            ],
+            "examples/python/nav_track.py": [
+                ([log], "Python types not found", False),
+                (["--types", types, missing], "cannot read " + missing, False),
+                (["--types", types, empty_dir], "cannot read " + empty_dir, False),
+            ],
+            "services/tools/plot_flight.py": [
+                ([missing], "results folder not found", False),
+                ([empty_dir], "required file missing", False),
+                ([os.path.join(d, "unreadable")], "cannot read", False),
+                ([results, "--scenario", missing], "--scenario: no file", False),
+                ([results, "--scenario", broken], "not valid YAML", False),
+                ([results], "python3-numpy", True),
+            ],
+        }
+
+    def program(self, entry_point, *args, env=None):
+        return run([sys.executable, os.path.join(REPO_ROOT, entry_point)] + list(args),
+                   env=env or self.plain_env)
+
+    def test_the_walk_finds_the_entry_points(self):
+        for known in ("deploy/launch.py", "bench/monte_carlo.py", "services/tools/plot_flight.py",
+                      "bench/plot_tracking_sweep.py", "examples/python/nav_track.py"):
+            self.assertIn(known, self.entry_points)
+        self.assertNotIn("services/tools/ofn_cli.py", self.entry_points)  # a module, no program
+        self.assertFalse([e for e in self.entry_points if e.startswith(("tests/", "build/"))])
+
+    def test_help_and_version_without_numpy_matplotlib_yaml(self):
+        version = project_version()
+        for entry_point in self.entry_points:
+            with self.subTest(entry_point=entry_point):
+                result = self.program(entry_point, "--help", env=self.no_modules)
+                self.assertEqual(result.returncode, 0, result.stderr)
+                self.assertTrue(result.stdout.startswith("usage: " + entry_point), result.stdout)
+                result = self.program(entry_point, "--version", env=self.no_modules)
+                self.assertEqual(result.returncode, 0, result.stderr)
+                self.assertEqual(result.stdout.strip(), "%s %s" % (entry_point, version))
+
+    def test_unknown_option_is_one_line(self):
+        for entry_point in self.entry_points:
+            with self.subTest(entry_point=entry_point):
+                result = self.program(entry_point, "--no-such-option", env=self.no_modules)
+                self.assert_one_line_error(result, 2, entry_point + ": error: ")
+
+    def test_help_shows_every_default(self):
+        for entry_point in self.entry_points:
+            module = load_module(os.path.join(REPO_ROOT, entry_point))
+            self.assertTrue(hasattr(module, "build_parser"), entry_point + " has no build_parser()")
+            for action in module.build_parser()._actions:
+                if action.dest in ("help", "version") or action.help == "==SUPPRESS==":
+                    continue
+                with self.subTest(entry_point=entry_point,
+                                  option=action.option_strings or action.dest):
+                    shown = (action.help or "") % dict(vars(action), prog=entry_point)
+                    self.assertRegex(shown, r"\((default: [^)]+|required)\)$")
+
+    def test_bad_inputs_are_one_line_errors(self):
+        table = self.bad_inputs()
+        self.assertEqual(sorted(table), sorted(self.entry_points),
+                         "every Python entry point needs its bad inputs in bad_inputs()")
+        for entry_point, cases in table.items():
+            self.assertTrue(any(hidden for _, _, hidden in cases) or
+                            entry_point == "examples/python/nav_track.py",
+                            entry_point + ": no missing-module case")
+            for args, fragment, hidden in cases:
+                with self.subTest(entry_point=entry_point, args=args):
+                    result = self.program(entry_point, *args,
+                                          env=self.no_modules if hidden else None)
+                    self.assert_one_line_error(result, 2, fragment)
+                    self.assertRegex(result.stderr, "^(%s|%s): error: " % (
+                        re.escape(entry_point), re.escape(os.path.basename(entry_point))))
 
 
 # ---------------------------------------------------------------------------
@@ -415,10 +596,10 @@ HELP_PATH_RE = re.compile(r"(?<![\w./*$<{-])((?:[\w.-]+/)+[\w.-]+\.(?:yaml|py|sh
 
 class HelpExamplesTest(unittest.TestCase):
     def test_files_named_in_help_texts_exist(self):
-        commands = [[sys.executable, os.path.join(DEPLOY, "launch.py"), "--help"]]
+        commands = [[sys.executable, os.path.join(REPO_ROOT, p), "--help"]
+                    for p in python_entry_points()]
         commands += [[os.path.join(DEPLOY, s), "--help"]
                      for s in ("fly.sh", "replay.sh", "spy.sh", "netns.sh", "watch.sh")]
-        commands += [[sys.executable, os.path.join(BENCH, s), "--help"] for s in BENCH_SCRIPTS]
         for cmd in commands:
             result = run(cmd)
             self.assertEqual(result.returncode, 0, result.stderr)
