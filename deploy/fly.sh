@@ -70,7 +70,7 @@ fi
 mkdir -p "$out"
 
 launch=(/usr/bin/python3 "$repo/deploy/launch.py" --scenario "$scenario" --rtf "$rtf"
-        --log-dir "$out" --timeout "$timeout")
+        --out "$out" --timeout "$timeout")
 echo "fly: scenario $scenario, real-time factor $rtf, results in $out"
 status=0
 if [[ $watch == 1 ]]; then

@@ -425,7 +425,7 @@ start_host() {  # start_host NAME LAUNCHER_OPTIONS...
   launcher_pid[$h]=$!
 }
 # The ground station first: its lcm-logger records the whole flight.
-start_host gcs --log-dir "$out" --timeout "$timeout"
+start_host gcs --out "$out" --timeout "$timeout"
 deadline=$((SECONDS + 30))
 while [[ ! -f "$out/latest_log" && $SECONDS -lt $deadline && -z $interrupted ]] &&
       kill -0 "${launcher_pid[gcs]}" 2>/dev/null; do
@@ -440,7 +440,7 @@ fi
 onboard_limit=$(awk -v t="$timeout" 'BEGIN { print (t > 0) ? t + 60 : 0 }')
 if [[ -f "$out/latest_log" && -z $interrupted ]]; then
   for h in onboard2 onboard1; do
-    start_host "$h" --no-record --log-dir "$out/$h" --timeout "$onboard_limit"
+    start_host "$h" --no-record --out "$out/$h" --timeout "$onboard_limit"
   done
 fi
 

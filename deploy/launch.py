@@ -19,9 +19,9 @@ restart: true service are restarted up to --max-restarts times in a row;
 a service that then runs --healthy-after seconds gets its budget back.
 
 Each service's output goes to the terminal prefixed with [name] and to
-<log_dir>/<flight-stem>/<name>.log; the LCM traffic goes to
-<log_dir>/<flight-stem>.lcm, whose path is also written to
-<log_dir>/latest_log.
+<out>/<flight-stem>/<name>.log; the LCM traffic goes to
+<out>/<flight-stem>.lcm, whose path is also written to <out>/latest_log
+(--out DIR, the results folder; --log-dir DIR is its old spelling).
 
 Exit codes: the ends_run process's exit code when it ends the run; 2 for bad
 input (arguments, table, scenario or config files, missing executables) and
@@ -98,8 +98,8 @@ RESOURCE_SETTLE_S = 60.0
 PLACEHOLDERS = ("bin", "scenario", "rtf", "lcm_url", "timeout", "log_dir", "flight_dir")
 # The option that sets each placeholder, for error messages.
 PLACEHOLDER_OPTIONS = {"bin": "--bin", "scenario": "--scenario", "rtf": "--rtf",
-                       "lcm_url": "--lcm-url", "timeout": "--timeout", "log_dir": "--log-dir",
-                       "flight_dir": "--log-dir"}
+                       "lcm_url": "--lcm-url", "timeout": "--timeout", "log_dir": "--out",
+                       "flight_dir": "--out"}
 # "{name}" but not "${name}", so shell snippets in commands keep working.
 PLACEHOLDER_RE = re.compile(r"(?<!\$)\{([A-Za-z_][A-Za-z0-9_]*)\}")
 NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
@@ -798,8 +798,9 @@ def build_parser():
     parser.add_argument("--lcm-url", metavar="URL", default=os.environ.get("LCM_DEFAULT_URL") or FALLBACK_LCM_URL,
                         help="LCM URL, {lcm_url} (default: $LCM_DEFAULT_URL or %s)"
                              % FALLBACK_LCM_URL.replace("%", "%%"))
-    parser.add_argument("--log-dir", default=DEFAULT_LOG_DIR, metavar="DIR",
-                        help="where flight logs and service logs go, {log_dir} (default: results/)")
+    parser.add_argument("--out", "--log-dir", dest="log_dir", default=DEFAULT_LOG_DIR, metavar="DIR",
+                        help="results folder: the flight log, the services' logs and latest_log, "
+                             "{log_dir}; --log-dir is its old spelling (default: results/)")
     parser.add_argument("--timeout", type=float, default=300.0, metavar="S",
                         help="overall wall-clock run limit in seconds, also {timeout}; "
                              "0 = no launcher limit, {timeout} then is 0 (default: 300)")
@@ -1094,7 +1095,7 @@ def main(argv=None):
         os.makedirs(log_dir, exist_ok=True)
         os.makedirs(service_log_dir)
     except OSError as e:
-        sys.stderr.write("launch.py: error: --log-dir: cannot create %s: %s\n" % (log_dir, e.strerror))
+        sys.stderr.write("launch.py: error: --out: cannot create %s: %s\n" % (log_dir, e.strerror))
         return EXIT_BAD_INPUT
 
     console = Console(max(len(name) for name in [s.name for s in specs] + ["lcm-logger"]))

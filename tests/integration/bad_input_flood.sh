@@ -7,7 +7,7 @@
 # a reference faster than the limit, and the flight completes.
 source "$(dirname "$0")/common.sh"
 /usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/open.yaml" \
-  --bin "$BIN" --rtf 4 --log-dir "$WORK/run" --timeout 150 --no-pin --max-restarts 0 \
+  --bin "$BIN" --rtf 4 --out "$WORK/run" --timeout 150 --no-pin --max-restarts 0 \
   > "$WORK/launch.txt" 2>&1 &
 launcher=$!
 # The live viewer listens to the same flood.

@@ -6,7 +6,7 @@
 # benchmarks' failure line) from the real wall.
 source "$(dirname "$0")/common.sh"
 /usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/bench3.yaml" \
-  --bin "$BIN" --rtf 2 --log-dir "$WORK/run" --timeout 150 --no-pin > "$WORK/launch.txt" 2>&1 ||
+  --bin "$BIN" --rtf 2 --out "$WORK/run" --timeout 150 --no-pin > "$WORK/launch.txt" 2>&1 ||
   { tail -40 "$WORK/launch.txt"; fail "launcher exit code $?"; }
 log=$(cat "$WORK/run/latest_log")
 # Exit 1 is the report's verdict of failure; what this test requires is

@@ -13,7 +13,7 @@ sed '/ofn_flight_monitor/ s|"--scenario", "{scenario}"\]|"--scenario", "{scenari
   "$REPO/deploy/processes.yaml" > "$WORK/processes.yaml"
 grep -q -- '"--silence", "2"' "$WORK/processes.yaml" || fail "the monitor's command line was not found in deploy/processes.yaml"
 /usr/bin/python3 "$REPO/deploy/launch.py" --table "$WORK/processes.yaml" --scenario "$scenario" \
-  --bin "$BIN" --rtf 2 --log-dir "$WORK/run" --timeout 200 --no-pin > "$WORK/launch.txt" 2>&1 &
+  --bin "$BIN" --rtf 2 --out "$WORK/run" --timeout 200 --no-pin > "$WORK/launch.txt" 2>&1 &
 launcher=$!
 # Wait for the optimiser to engage (its log line reaches the launcher's output).
 for _ in $(seq 1 120); do

@@ -5,7 +5,7 @@
 # resumes the same flight from its checkpoint (no jump back to the start).
 source "$(dirname "$0")/common.sh"
 /usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/open.yaml" \
-  --bin "$BIN" --rtf 4 --log-dir "$WORK/run" --timeout 150 --no-pin > "$WORK/launch.txt" 2>&1 &
+  --bin "$BIN" --rtf 4 --out "$WORK/run" --timeout 150 --no-pin > "$WORK/launch.txt" 2>&1 &
 launcher=$!
 # Wait until the vehicle is well into the flight (about 20 s of flight time).
 sleep 6

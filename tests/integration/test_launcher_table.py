@@ -58,7 +58,7 @@ class LauncherTestCase(unittest.TestCase):
 
     def run_launcher(self, table, *extra, timeout=60):
         cmd = [sys.executable, LAUNCHER, "--table", table, "--scenario", self.scenario,
-               "--log-dir", self.log_dir, "--no-record", "--no-pin"] + list(extra)
+               "--out", self.log_dir, "--no-record", "--no-pin"] + list(extra)
         return subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                               text=True, timeout=timeout, cwd=REPO_ROOT)
 
@@ -311,7 +311,7 @@ class PreflightTest(LauncherTestCase):
         empty = os.path.join(self.dir, "empty-path")
         os.mkdir(empty)
         cmd = [sys.executable, LAUNCHER, "--table", table, "--scenario", self.scenario,
-               "--log-dir", self.log_dir, "--no-pin"]
+               "--out", self.log_dir, "--no-pin"]
         result = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                 timeout=60, cwd=REPO_ROOT, env=dict(os.environ, PATH=empty))
         self.assert_rejected(result, "lcm-logger not found", "apt-get install liblcm-bin",
@@ -327,6 +327,28 @@ class CommandLineTest(LauncherTestCase):
                                 stderr=subprocess.PIPE, text=True, timeout=60)
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertEqual(result.stdout.strip(), "deploy/launch.py " + version)
+
+    def test_out_and_its_old_spelling_log_dir(self):
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: monitor
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "echo {log_dir}"]
+                ends_run: true
+            """)
+        for option in ("--out", "--log-dir"):
+            with self.subTest(option=option):
+                results = os.path.join(self.dir, option.strip("-"))
+                cmd = [sys.executable, LAUNCHER, "--table", table, "--scenario", self.scenario,
+                       option, results, "--no-record", "--no-pin", "--timeout", "30"]
+                result = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                        text=True, timeout=60, cwd=REPO_ROOT)
+                self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+                self.assertRegex(result.stdout, r"\[monitor\]\s+" + re.escape(results) + r"\n")
+                self.assertEqual(len([d for d in os.listdir(results) if d.startswith("flight-")]), 1)
 
     def test_usage_error_is_one_line(self):
         for args in (["--scenario", self.scenario, "--rtf"], ["--scenario", self.scenario, "--bogus"],
@@ -484,7 +506,7 @@ class SupervisionTest(LauncherTestCase):
                 restart: true
             """ % pid_file)
         cmd = [sys.executable, LAUNCHER, "--table", table, "--scenario", self.scenario,
-               "--log-dir", self.log_dir, "--no-record", "--no-pin"]
+               "--out", self.log_dir, "--no-record", "--no-pin"]
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         try:
             deadline = time.monotonic() + 10
