@@ -87,4 +87,6 @@ exit_if_no_flight "$status"
 log=$(cat "$out/latest_log")
 echo
 report_flight "$repo/build/bin" "$out" "$scenario" "$log"
+[[ $watch == 1 ]] ||
+  echo "  watch live        : make run WATCH=1 (deploy/fly.sh --watch) shows the flight in a browser"
 finish_flight "$out" "$log" "$status"

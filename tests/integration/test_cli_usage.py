@@ -303,6 +303,8 @@ class FlyThenReplayTest(ScratchTestCase):
         flown = self.fly()
         self.assertEqual(flown.returncode, 0, flown.stdout + flown.stderr)
         self.assertIn("deploy/replay.sh latest", flown.stdout)
+        self.assertIn("make run WATCH=1 (deploy/fly.sh --watch) shows the flight in a browser",
+                      flown.stdout)
         runs = [d for d in os.listdir(os.path.join(self.repo, "results")) if d.startswith("run-")]
         self.assertEqual(len(runs), 1)
         with open(os.path.join(self.repo, "results", runs[0], "latest_log")) as f:
