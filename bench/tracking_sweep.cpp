@@ -81,8 +81,8 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(out_dir);
   std::ofstream md(out_dir + "/tracking_sweep.md");
   std::ofstream csv(out_dir + "/tracking_sweep.csv");
-  csv << "mass_scale,airframe,wind_kt,turbulence,adaptive_rms,adaptive_max,baseline_rms,"
-         "baseline_max\n";
+  csv << "mass_scale,airframe,wind [kt],turbulence,adaptive_rms [m],adaptive_max [m],"
+         "baseline_rms [m],baseline_max [m]\n";
   md << "Controller config `" << config_path << "`.\n\n"
      << "Tracking error (m, commanded minus true position) on `" << base.name << "`, " << duration
      << " s per case flown back and forth, crosswind with " << turbulence

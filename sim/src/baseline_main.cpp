@@ -91,7 +91,9 @@ void write_outputs(const std::string& dir, const ofn::Scenario& scenario,
   const std::string csv_path = dir + "/baseline_trajectory.csv";
   std::ofstream csv(csv_path);
   if (!csv) throw std::runtime_error("cannot write " + csv_path + ": " + std::strerror(errno));
-  csv << "t,north,east,down,vn,ve,vd,an,ae,ad\n" << std::setprecision(9);
+  csv << "t [s],north [m],east [m],down [m],vn [m/s],ve [m/s],vd [m/s],an [m/s^2],ae [m/s^2],"
+         "ad [m/s^2]\n"
+      << std::setprecision(9);
   for (const auto& s : r.trajectory)
     csv << s.t << ',' << s.position.x() << ',' << s.position.y() << ',' << s.position.z() << ','
         << s.velocity.x() << ',' << s.velocity.y() << ',' << s.velocity.z() << ','

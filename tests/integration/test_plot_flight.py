@@ -17,6 +17,7 @@ repository root:
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -400,6 +401,67 @@ class CourseFigureTest(unittest.TestCase):
         self.assertEqual(len(lines_with_gid(clr, "R_s")), 1)
         self.assertEqual(len(lines_with_gid(clr, "0.8 R_s")), 1)
         self.assertEqual(len(lines_with_gid(clr, "clearance")), 1)
+
+
+def written_header(source):
+    """The CSV header line a C++ program writes (the string literal(s) after
+    `csv << `), so that the readers here are tested on what is written."""
+    with open(os.path.join(REPO_ROOT, source)) as f:
+        text = f.read()
+    literal = re.search(r'csv << ((?:"[^"]*"\s*)+)', text).group(1)
+    return "".join(re.findall(r'"([^"]*)"', literal)).replace("\\n", "")
+
+
+class WrittenHeadersTest(unittest.TestCase):
+    """baseline_trajectory.csv (ofn_baseline) and tracking_sweep.csv
+    (ofn_tracking_sweep) name their units, and their readers read them."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory(prefix="ofn-headers-test-")
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_baseline_trajectory_has_units_and_is_drawn(self):
+        header = written_header("sim/src/baseline_main.cpp").split(",")
+        self.assertEqual(header[:4], ["t [s]", "north [m]", "east [m]", "down [m]"])
+        self.assertTrue(all(re.search(r" \[[^]]+\]$", h) for h in header), header)
+        run_dir, base_dir = os.path.join(self.dir, "run"), os.path.join(self.dir, "base")
+        os.makedirs(run_dir)
+        os.makedirs(base_dir)
+        write_results(run_dir)
+        t = np.arange(0.0, 18.0, 0.1)
+        n, e, d = -20.0 + 8.0 * t, 0.0 * t, 0.0 * t - ALTITUDE
+        write_csv(os.path.join(base_dir, "baseline_trajectory.csv"), header,
+                  zip(t, n, e, d, t * 0 + 8.0, t * 0, t * 0, t * 0, t * 0, t * 0))
+        fig = cr.course_figure_of(run_dir, title="with baseline", baseline_dir=base_dir)
+        try:
+            top = axes_named(fig, "top view")
+            dashed = [line for line in top.get_lines() if line.get_linestyle() == "--"]
+            self.assertEqual(len(dashed), 1, [line.get_label() for line in top.get_lines()])
+            x, _ = dashed[0].get_data()
+            self.assertAlmostEqual(float(np.max(x)), float(np.max(n)) / FT, places=3)
+        finally:
+            plt.close(fig)
+
+    def test_tracking_sweep_has_units_and_is_drawn(self):
+        header = written_header("bench/tracking_sweep.cpp")
+        self.assertIn("wind [kt]", header.split(","))
+        self.assertIn("adaptive_rms [m]", header.split(","))
+        script = os.path.join(REPO_ROOT, "bench", "plot_tracking_sweep.py")
+        rows = '1,"nominal",0,light,0.2,0.5,0.3,0.9\n1.2,"nominal",10,light,0.4,1.0,2.5,6.0\n'
+        for name, head in (("units", header), ("old", header.replace(" [kt]", "_kt")
+                                                               .replace(" [m]", ""))):
+            csv_path = os.path.join(self.dir, name + ".csv")
+            with open(csv_path, "w") as f:
+                f.write(head + "\n" + rows)
+            run = subprocess.run([sys.executable, script, csv_path], stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, text=True, timeout=120)
+            self.assertEqual(run.returncode, 0, run.stderr)
+            png = os.path.join(self.dir, name + ".png")
+            self.assertEqual(run.stdout.strip(), "wrote " + png)
+            self.assertGreater(os.path.getsize(png), 10000)
 
 
 if __name__ == "__main__":
