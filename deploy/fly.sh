@@ -8,6 +8,8 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 program=fly.sh
 # shellcheck source=deploy/flight_common.sh
 source "$repo/deploy/flight_common.sh"
+# shellcheck source=deploy/version.sh
+source "$repo/deploy/version.sh"
 scenario="$repo/sim/scenarios/bench3.yaml"
 rtf=1.0
 timeout=300
@@ -36,6 +38,7 @@ channel, summary.json, summary.txt and the figures flight.png, tracking.png.
                     page on 127.0.0.1; its URL is printed (default: off)
   --port N          the page's HTTP port with --watch (default: 8765)
   -h, --help        show this help
+  --version         show the version
 
 The flight's LCM log is named in DIR/latest_log; replay the most recent
 flight with 'deploy/replay.sh latest'.
@@ -57,6 +60,7 @@ while [[ $# -gt 0 ]]; do
     --port) need_value "$1" $#; port=$2; shift 2 ;;
     --port=*) port=${1#*=}; shift ;;
     -h|--help) usage; exit 0 ;;
+    --version) echo "fly.sh $(project_version "$repo")"; exit 0 ;;
     *) flight_option "$@"; shift "$taken" ;;
   esac
 done

@@ -13,6 +13,8 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 program=fly_three_hosts.sh
 # shellcheck source=deploy/flight_common.sh
 source "$repo/deploy/flight_common.sh"
+# shellcheck source=deploy/version.sh
+source "$repo/deploy/version.sh"
 scenario="$repo/sim/scenarios/bench3.yaml"
 rtf=1.0
 timeout=300
@@ -52,6 +54,7 @@ report and figures are written as deploy/fly.sh writes them. Needs root.
                     host given policy.yaml, the public keys and its own key)
   --open-bus        no authentication: the bus as on one host
   -h, --help        show this help
+  --version         show the version
 
 Besides fly.sh's files, DIR holds onboard1/ and onboard2/ (those hosts'
 service logs; gcs's are in DIR/flight-<date>/ next to the recording),
@@ -81,6 +84,7 @@ while [[ $# -gt 0 ]]; do
     --bus-keys=*) bus_keys=${1#*=}; shift ;;
     --open-bus) open_bus=1; shift ;;
     -h|--help) usage; exit 0 ;;
+    --version) echo "fly_three_hosts.sh $(project_version "$repo")"; exit 0 ;;
     *) flight_option "$@"; shift "$taken" ;;
   esac
 done

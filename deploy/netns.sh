@@ -15,6 +15,7 @@ multicast, so its traffic never leaves the machine.
   --fallback   run COMMAND on the host network when no namespace can be made
                (default: fail with exit code 1)
   -h, --help   show this help
+  --version    show the version
 
 Example:
   deploy/netns.sh --fallback deploy/launch.py --scenario sim/scenarios/bench3.yaml
@@ -26,6 +27,12 @@ EOF
 fallback=0
 case "${1:-}" in
   -h|--help) usage; exit 0 ;;
+  --version)
+    # shellcheck source=deploy/version.sh
+    source "$(dirname "$0")/version.sh"
+    echo "netns.sh $(project_version "$(cd "$(dirname "$0")/.." && pwd)")"
+    exit 0
+    ;;
   --fallback) fallback=1; shift ;;
 esac
 if [[ $# -eq 0 ]]; then

@@ -7,6 +7,8 @@
 set -euo pipefail
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=deploy/version.sh
+source "$REPO_ROOT/deploy/version.sh"
 LCM_URL="${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}"
 SPEED=1.0
 LOOP=0
@@ -43,6 +45,7 @@ Publishes the messages of a recorded flight on LCM with their original timing.
                     plans on the bus are then theirs (default: no services)
   -v, --verbose     print every replayed message
   -h, --help        show this help
+  --version         show the version
 
 Exit codes: lcm-logplayer's; 2 for bad arguments or an unusable LOGFILE;
 1 when lcm-logplayer is missing or fails during --loop.
@@ -86,6 +89,7 @@ while [ $# -gt 0 ]; do
         --loop)       LOOP=1; shift ;;
         --verbose|-v) VERBOSE=1; shift ;;
         -h|--help)    usage; exit 0 ;;
+        --version)    echo "replay.sh $(project_version "$REPO_ROOT")"; exit 0 ;;
         -*)           die_usage "unknown option '$1'" ;;
         *)
             [ -z "$LOGFILE" ] || die_usage "only one LOGFILE allowed (got '$LOGFILE' and '$1')"

@@ -9,6 +9,8 @@
 set -euo pipefail
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=deploy/version.sh
+source "$REPO_ROOT/deploy/version.sh"
 LCM_JAR=/usr/share/java/lcm.jar
 JCHART_JAR=/usr/share/java/jchart2d.jar
 TYPES_JAR="${OFN_LCMTYPES_JAR:-$REPO_ROOT/build/lcmtypes/ofn_lcmtypes.jar}"
@@ -23,6 +25,7 @@ Opens lcm-spy on the flight-software LCM bus with the ofn_* message types.
   --lcm-url URL   LCM URL to listen on
                   (default: \$LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0)
   -h, --help      show this help
+  --version       show the version
 
 Exit codes: lcm-spy's; 2 for bad arguments; 1 when something it needs is
 missing.
@@ -57,6 +60,10 @@ while [ $# -gt 0 ]; do
             ;;
         -h|--help)
             usage
+            exit 0
+            ;;
+        --version)
+            echo "spy.sh $(project_version "$REPO_ROOT")"
             exit 0
             ;;
         *)

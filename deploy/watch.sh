@@ -8,6 +8,8 @@
 # first message.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=deploy/version.sh
+source "$repo/deploy/version.sh"
 bin="$repo/build/bin"
 port=8765
 keep=0
@@ -31,6 +33,7 @@ opens it when a browser and a display are available.
   --host-network    run COMMAND and the viewer on the host network instead
                     (default: a namespace when one can be made)
   -h, --help        show this help
+  --version         show the version
 
 Joining another namespace needs root (CAP_SYS_ADMIN). Without it, or when
 no namespace can be made, COMMAND and the viewer share the host network
@@ -59,6 +62,7 @@ while [[ $# -gt 0 ]]; do
     --keep) keep=1; shift ;;
     --host-network) host_network=1; shift ;;
     -h | --help) usage; exit 0 ;;
+    --version) echo "watch.sh $(project_version "$repo")"; exit 0 ;;
     --) shift; break ;;
     -*) die_usage "unknown option '$1'" ;;
     *) break ;;

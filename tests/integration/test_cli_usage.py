@@ -228,6 +228,24 @@ class SpyAndNetnsUsageTest(ScratchTestCase):
         self.assert_one_line_error(run([netns, "--fallback"]), 2, "missing COMMAND")
 
 
+class DeployScriptVersionTest(ScratchTestCase):
+    """Every executable deploy script (found by listing deploy/, so that a
+    new one cannot be left out) prints its name and the project's version
+    for --version and lists --version in its help."""
+
+    def test_every_script_has_version(self):
+        scripts = sorted(name for name in os.listdir(DEPLOY)
+                         if name.endswith(".sh")
+                         and os.access(os.path.join(DEPLOY, name), os.X_OK))
+        self.assertGreaterEqual(len(scripts), 6, scripts)
+        for name in scripts:
+            with self.subTest(script=name):
+                result = run([os.path.join(DEPLOY, name), "--version"])
+                self.assertEqual(result.returncode, 0, result.stderr)
+                self.assertEqual(result.stdout.strip(), "%s %s" % (name, project_version()))
+                self.assertIn("--version", run([os.path.join(DEPLOY, name), "--help"]).stdout)
+
+
 class FlyThenReplayTest(ScratchTestCase):
     """`make run` (deploy/fly.sh) then `deploy/replay.sh latest`, in a scratch
     copy of the repository with stand-ins for LCM and the build."""
@@ -237,7 +255,8 @@ class FlyThenReplayTest(ScratchTestCase):
         self.repo = os.path.join(self.dir, "repo")
         for sub in ("deploy", "build/bin", "services/tools", "config", "sim/scenarios"):
             os.makedirs(os.path.join(self.repo, sub))
-        for name in ("fly.sh", "flight_common.sh", "launch.py", "netns.sh", "replay.sh"):
+        for name in ("fly.sh", "flight_common.sh", "launch.py", "netns.sh", "replay.sh",
+                     "version.sh"):
             shutil.copy2(os.path.join(DEPLOY, name), os.path.join(self.repo, "deploy", name))
         shutil.copy2(os.path.join(REPO_ROOT, "services", "tools", "ofn_cli.py"),
                      os.path.join(self.repo, "services", "tools", "ofn_cli.py"))
