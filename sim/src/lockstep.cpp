@@ -41,7 +41,7 @@ bool Lockstep::run(Utime end, const std::function<bool()>& stop) {
     if (next == INT64_MIN) next = clock_.now();  // timers not scheduled yet: start now
     if (next == INT64_MAX || next > end) return false;
     if (next > clock_.now()) clock_.set(next);
-    for (Node* n : nodes_) n->fire_due_timers(clock_.now());
+    for (Node* n : nodes_) n->fire_due_timers();
     deliver_all();
     ++steps_;
     if (stop && stop()) return true;

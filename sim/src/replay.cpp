@@ -451,7 +451,7 @@ class Session {
 
   void fire_timers() {
     for (auto& service : services_) {
-      service.node->fire_due_timers(clock_.now());
+      service.node->fire_due_timers();
       drain(service);
     }
   }

@@ -149,10 +149,12 @@ int main(int argc, char** argv) {
     std::map<std::string, ofn::bus_auth::PublicKey> keys;
     for (const auto& role : policy.roles())
       keys[role] = ofn::bus_auth::read_public_key(dir + role + ".pub");
+    // The clock goes with the signer (by value): this block ends before it
+    // signs anything.
     const ofn::WallClock wall;
     g_forger = std::make_unique<ofn::bus_auth::Authenticator>(
         sign_as, ofn::bus_auth::read_secret_key(dir + sign_as + ".key"), keys, policy,
-        [&wall] { return wall.now(); });
+        [wall] { return wall.now(); });
   }
 
   lcm::LCM lcm(url);

@@ -79,7 +79,7 @@ class SensorInterfaceServiceTest : public ::testing::Test {
     for (Utime next = service_.node().next_deadline(); next <= t;
          next = service_.node().next_deadline()) {
       clock_.set(std::max(clock_.now(), next));
-      service_.node().fire_due_timers(clock_.now());
+      service_.node().fire_due_timers();
       deliver();
     }
     clock_.set(t);

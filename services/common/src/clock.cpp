@@ -7,8 +7,12 @@
 namespace ofn {
 
 Utime WallClock::now() const {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(system_().time_since_epoch())
+      .count();
+}
+
+Utime WallClock::timer_now() const {
+  return std::chrono::duration_cast<std::chrono::microseconds>(steady_().time_since_epoch())
       .count();
 }
 

@@ -105,7 +105,7 @@ void Node::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Su
     if (fate.delay > 0.0 && node.clock_.valid()) {
       const auto* bytes = static_cast<const uint8_t*>(rbuf->data);
       // After those due at the same time: they arrived first.
-      node.held_.emplace(node.clock_.now() + to_utime(fate.delay),
+      node.held_.emplace(node.clock_.timer_now() + to_utime(fate.delay),
                          HeldMessage{sub, std::vector<uint8_t>(bytes, bytes + rbuf->data_size)});
       return;
     }
@@ -187,7 +187,7 @@ void Node::reject(const std::string& channel, const std::string& reason) {
   else
     ++counters_.rejected_by_reason[kOtherRejectKind];
   // One line per second at most, so a flood of bad input cannot flood the log.
-  const Utime now = clock_.valid() ? clock_.now() : 0;
+  const Utime now = clock_.valid() ? clock_.timer_now() : 0;
   if (last_reject_log_ == INT64_MIN || now - last_reject_log_ >= kMicrosPerSecond ||
       now < last_reject_log_) {
     log_->warn(
@@ -218,31 +218,41 @@ Utime Node::next_deadline() const {
   return next;
 }
 
-void Node::fire_due_timers(Utime now, int max_catch_up) {
+void Node::fire_due_timers() {
   if (!clock_.valid()) return;
+  const Utime now = clock_.timer_now();
   deliver_held(now);
   if (start_time_ == INT64_MIN) start_time_ = now;
   for (auto& t : timers_) {
+    if (t.deadline != INT64_MIN && t.deadline - now > t.period_us) {
+      // Due more than a period ahead: the clock went back. Waiting for the
+      // old deadline would silence the timer for as long as the step.
+      log_->warn("timer '{}': the clock went back by about {:.3f} s; starting on its period afresh",
+                 t.label, to_seconds(t.deadline - t.period_us - now));
+      t.deadline = INT64_MIN;
+    }
     if (t.deadline == INT64_MIN) {
       // Align to whole multiples of the period so that lockstep runs are
       // reproducible and rates line up across services.
       t.deadline = (now / t.period_us) * t.period_us;
       if (t.deadline < now) t.deadline += t.period_us;
     }
-    int fired = 0;
-    while (t.deadline <= now) {
-      if (fired == max_catch_up) {
-        const Utime behind = (now - t.deadline) / t.period_us + 1;
-        t.overruns += behind;
-        t.deadline += behind * t.period_us;
-        log_->warn("timer '{}' fell {} periods behind; skipped ahead", t.label, behind);
-        break;
-      }
-      const auto begin = std::chrono::steady_clock::now();
-      t.callback();
-      account_work(std::chrono::steady_clock::now() - begin);
-      t.deadline += t.period_us;
-      ++fired;
+    if (t.deadline > now) continue;
+    const auto begin = std::chrono::steady_clock::now();
+    t.callback();
+    account_work(std::chrono::steady_clock::now() - begin);
+    // The periods missed beyond this one are not run: the same callback
+    // at the same time again and again (up to a thousand after a jump of
+    // the clock) only repeated what this call did.
+    const Utime missed = (now - t.deadline) / t.period_us;
+    t.deadline += (missed + 1) * t.period_us;
+    if (missed > 0) {
+      t.overruns += missed;
+      if (missed * t.period_us >= kMicrosPerSecond)
+        log_->warn(
+            "timer '{}' fell {} periods ({:.3f} s) behind; fired once and kept to its "
+            "period ({} missed in all)",
+            t.label, missed, to_seconds(missed * t.period_us), t.overruns);
     }
   }
 }
@@ -274,7 +284,7 @@ void Node::publish_heartbeat() {
   hb.loop_time_mean = work_calls_ ? work_total_ / static_cast<double>(work_calls_) : 0.0;
   hb.loop_time_max = work_max_;
   hb.cpu_fraction = wall_period > 0 ? work_total_ / wall_period : 0.0;
-  hb.uptime = start_time_ == INT64_MIN ? 0.0 : to_seconds(hb.utime - start_time_);
+  hb.uptime = start_time_ == INT64_MIN ? 0.0 : to_seconds(clock_.timer_now() - start_time_);
   publish(heartbeat_channel(name_), hb);
   work_calls_ = 0;
   work_total_ = 0.0;

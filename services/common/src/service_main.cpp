@@ -123,16 +123,16 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
   }
 
   while (!g_stop.load() && (!keep_running || keep_running())) {
-    const Utime now = clock.now();
     Utime next = INT64_MAX;
     for (Node* node : nodes) {
-      node->fire_due_timers(now);
+      node->fire_due_timers();
       next = std::min(next, node->next_deadline());
     }
     int wait_ms = 50;
     const double scale = clock.wall_seconds_per_clock_second();
     if (scale > 0 && next != INT64_MAX) {
-      const double wait = to_seconds(next - clock.now()) * scale;
+      // Deadlines are in timer time (monotonic for the wall clock).
+      const double wait = to_seconds(next - clock.timer_now()) * scale;
       wait_ms = static_cast<int>(std::clamp(wait * 1000.0, 0.0, 50.0));
     }
     if (lcm.handleTimeout(wait_ms) < 0) {

@@ -12,7 +12,9 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
+#include "ofn/common/message_caps.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/validate/heartbeat.hpp"
 #include "ofn/common/validate/nav_state.hpp"
@@ -165,7 +167,7 @@ TEST_F(NodeTest, TimerFiresOncePerPeriodOfClockTime) {
       0.01, [&] { fired.push_back(clock_.now()); }, "10ms");
   for (Utime t = 1000; t <= kMicrosPerSecond; t += 1000) {
     clock_.set(t);
-    node.fire_due_timers(t);
+    node.fire_due_timers();
   }
   EXPECT_EQ(fired.size(), 100u);
   // On whole multiples of the period, 10 ms apart.
@@ -179,23 +181,68 @@ TEST_F(NodeTest, TimerFiresOncePerPeriodOfClockTime) {
   deliver();
 }
 
-TEST_F(NodeTest, TimerCatchesUpThenSkipsAheadWhenFarBehind) {
+TEST_F(NodeTest, ALateTimerFiresOnceAndKeepsToItsPeriod) {
   clock_.set(0);
   Node node("timers", lcm_, clock_);
-  int fired = 0;
+  std::vector<Utime> fired;
   node.add_timer(
-      0.01, [&] { ++fired; }, "10ms");
-  node.fire_due_timers(0);
-  EXPECT_EQ(fired, 1);
-  // 50 ms late: the missed periods are run.
-  clock_.set(50000);
-  node.fire_due_timers(50000);
-  EXPECT_EQ(fired, 6);
-  // 10 s late with a catch-up bound of 5: five runs, then it skips ahead.
-  clock_.set(50000 + 10 * kMicrosPerSecond);
-  node.fire_due_timers(clock_.now(), 5);
-  EXPECT_EQ(fired, 11);
-  EXPECT_GT(node.next_deadline(), clock_.now());
+      0.01, [&] { fired.push_back(clock_.now()); }, "10ms");
+  node.fire_due_timers();
+  EXPECT_EQ(fired.size(), 1u);
+  // 45 ms late (a starved process): once, not the four periods it missed.
+  clock_.set(55000);
+  node.fire_due_timers();
+  EXPECT_EQ(fired.size(), 2u);
+  // Then on its period again, at the next whole multiple.
+  EXPECT_EQ(node.next_deadline(), 60000);
+  clock_.set(60000);
+  node.fire_due_timers();
+  EXPECT_EQ(fired.size(), 3u);
+  EXPECT_EQ(fired.back(), 60000);
+  deliver();
+}
+
+TEST_F(NodeTest, AClockJumpAheadFiresATimerOnceNotABurst) {
+  clock_.set(0);
+  Node node("timers", lcm_, clock_);
+  std::vector<Utime> fired;
+  node.add_timer(
+      0.01, [&] { fired.push_back(clock_.now()); }, "10ms");
+  node.fire_due_timers();
+  // 1,000 s ahead: 100,000 periods missed; one callback.
+  const Utime jumped = 1000 * kMicrosPerSecond + 3000;
+  clock_.set(jumped);
+  node.fire_due_timers();
+  ASSERT_EQ(fired.size(), 2u);
+  EXPECT_EQ(fired[1], jumped);
+  // No silence after it: every 10 ms from the next multiple on.
+  for (Utime t = jumped; t <= jumped + 100000; t += 1000) {
+    clock_.set(t);
+    node.fire_due_timers();
+  }
+  ASSERT_EQ(fired.size(), 12u);
+  for (size_t i = 3; i < fired.size(); ++i) EXPECT_EQ(fired[i] - fired[i - 1], 10000) << i;
+  EXPECT_EQ(fired[2], 1000 * kMicrosPerSecond + 10000);
+  deliver();
+}
+
+TEST_F(NodeTest, AClockThatGoesBackDoesNotSilenceATimer) {
+  clock_.set(1000 * kMicrosPerSecond);
+  Node node("timers", lcm_, clock_);
+  std::vector<Utime> fired;
+  node.add_timer(
+      0.01, [&] { fired.push_back(clock_.now()); }, "10ms");
+  node.fire_due_timers();
+  ASSERT_EQ(fired.size(), 1u);
+  // 1,000 s back: the old deadline is 1,000 s away; the timer starts on its
+  // period afresh instead of waiting for it.
+  for (Utime t = 5000; t <= 105000; t += 1000) {
+    clock_.set(t);
+    node.fire_due_timers();
+  }
+  ASSERT_EQ(fired.size(), 11u);
+  EXPECT_EQ(fired[1], 10000);
+  for (size_t i = 2; i < fired.size(); ++i) EXPECT_EQ(fired[i] - fired[i - 1], 10000) << i;
   deliver();
 }
 
@@ -226,7 +273,7 @@ TEST_F(NodeTest, HeartbeatReportsServiceAndCounters) {
 
   for (Utime t = 0; t <= 2 * kMicrosPerSecond; t += 10000) {
     clock_.set(t);
-    node.fire_due_timers(t);
+    node.fire_due_timers();
     deliver();
   }
   ASSERT_EQ(beats.size(), 3u);  // one a second: at 0, 1 and 2 s
@@ -250,7 +297,7 @@ TEST_F(NodeTest, HeartbeatCarriesTheState) {
   Node monitor("monitor", lcm_, clock_);
   monitor.subscribe<heartbeat_t>(heartbeat_channel("svc"),
                                  [&](const heartbeat_t& h) { beats.push_back(h); });
-  node.fire_due_timers(0);
+  node.fire_due_timers();
   deliver();
   ASSERT_EQ(beats.size(), 1u);
   EXPECT_EQ(beats[0].state, "degraded");

@@ -14,11 +14,23 @@
 
 namespace ofn {
 
-/// The system clock: field deployment.
+/// The system clock: field deployment. Messages are stamped with the
+/// system time (microseconds since the epoch), which NTP or an operator may
+/// step; timers run on the monotonic clock, which never steps.
 class WallClock final : public Clock {
  public:
+  using SystemSource = std::chrono::system_clock::time_point (*)();
+  using SteadySource = std::chrono::steady_clock::time_point (*)();
+  explicit WallClock(SystemSource system = &std::chrono::system_clock::now,
+                     SteadySource steady = &std::chrono::steady_clock::now)
+      : system_(system), steady_(steady) {}
   Utime now() const override;
+  Utime timer_now() const override;
   std::string describe() const override { return "wall"; }
+
+ private:
+  SystemSource system_;
+  SteadySource steady_;
 };
 
 /// Simulation master clock: starts at `start` and advances at

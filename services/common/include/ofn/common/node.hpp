@@ -127,17 +127,21 @@ class Node {
   /// True when this node signs and checks every message (--bus-keys).
   bool authenticated() const { return auth_ != nullptr; }
 
-  /// Calls `callback` every `period` seconds of clock time, first at the first
-  /// tick of the node's clock that is a whole multiple of the period.
+  /// Calls `callback` every `period` seconds of the clock's timer time
+  /// (Clock::timer_now: clock time, but monotonic time for the wall
+  /// clock), first at the first tick that is a whole multiple of the period.
   void add_timer(double period, std::function<void()> callback, std::string label);
 
   /// Earliest timer deadline, or arrival of a message a simulated link
-  /// holds back (clock time); INT64_MAX when there is none.
+  /// holds back (timer time); INT64_MAX when there is none.
   Utime next_deadline() const;
-  /// Hands over the messages a simulated link held back until now, then
-  /// runs every timer due at or before `now`. A timer that fell more than
-  /// `max_catch_up` periods behind skips ahead and counts an overrun.
-  void fire_due_timers(Utime now, int max_catch_up = 1000);
+  /// Hands over the messages a simulated link held back until the clock's
+  /// timer time, then runs every timer due at or before it. Catch-up is
+  /// bounded under every clock: a timer that fell behind (a stopped or
+  /// starved process, a clock that jumped ahead) fires once and keeps to
+  /// its period from then on, the periods it missed counted, never run; one
+  /// whose clock went back starts on its period afresh, as at start.
+  void fire_due_timers();
   /// Schedules every timer afresh from the next clock tick, as at start: for
   /// a clock that was deliberately set to another timeline (a restarted
   /// simulation), where the old deadlines mean nothing.
@@ -158,10 +162,10 @@ class Node {
   struct Timer {
     double period;
     Utime period_us;
-    Utime deadline;  // INT64_MIN until scheduled from the first valid clock
+    Utime deadline;  // timer time; INT64_MIN until scheduled from the first valid clock
     std::function<void()> callback;
     std::string label;
-    int64_t overruns = 0;
+    int64_t overruns = 0;  // periods missed, not run
   };
 
   // A message a simulated link delays: for whom, and its bytes.
@@ -184,14 +188,14 @@ class Node {
   const Clock& clock_;
   std::shared_ptr<bus_auth::Authenticator> auth_;
   std::shared_ptr<LinkModel> link_;
-  std::multimap<Utime, HeldMessage> held_;  // by due time, then arrival
+  std::multimap<Utime, HeldMessage> held_;  // by due timer time, then arrival
   std::vector<uint8_t> publish_buffer_;
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
   std::vector<Timer> timers_;
   NodeCounters counters_;
   std::string state_ = "starting";
-  Utime start_time_ = INT64_MIN;
+  Utime start_time_ = INT64_MIN;  // timer time of the first firing
 
   // Work statistics over the current heartbeat period (wall time: it
   // measures CPU cost, it does not drive behaviour).
@@ -199,7 +203,7 @@ class Node {
   double work_total_ = 0.0;
   double work_max_ = 0.0;
   std::chrono::steady_clock::time_point period_start_;
-  // Rate limit for rejection log lines.
+  // Rate limit for rejection log lines (timer time).
   Utime last_reject_log_ = INT64_MIN;
   int64_t suppressed_rejects_ = 0;
 };

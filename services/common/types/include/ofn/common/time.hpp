@@ -23,7 +23,14 @@ inline Utime to_utime(double seconds) {
 class Clock {
  public:
   virtual ~Clock() = default;
+  /// Time of the clock: what messages are stamped with and judged by.
   virtual Utime now() const = 0;
+  /// Time the timers run on. The same as now() but for the wall clock,
+  /// whose now() steps with the system time (NTP, an operator setting the
+  /// date): its timers run on the monotonic clock, so that a step neither
+  /// fires a burst of callbacks nor silences them. Only differences of it
+  /// mean anything.
+  virtual Utime timer_now() const { return now(); }
   /// False until the clock has a time (a SIM_CLOCK-following clock before its
   /// first message).
   virtual bool valid() const { return true; }
