@@ -16,8 +16,10 @@
 #include "ofn/common/clock.hpp"
 #include "ofn/common/message_caps.hpp"
 #include "ofn/common/node.hpp"
+#include "ofn/common/validate/global_path.hpp"
 #include "ofn/common/validate/heartbeat.hpp"
 #include "ofn/common/validate/nav_state.hpp"
+#include "ofn/global_path_t.hpp"
 #include "ofn/heartbeat_t.hpp"
 #include "ofn/nav_state_t.hpp"
 #include "ofn/scan_world_t.hpp"
@@ -546,6 +548,76 @@ TEST_F(NodeTest, WithoutAuthenticationATrailerIsIgnoredAndOtherTailsAreNot) {
   EXPECT_EQ(handled_.size(), 1u);
   EXPECT_EQ(node.counters().rejected, 1);
   EXPECT_FALSE(node.authenticated());
+}
+
+global_path_t path_of(int points, Utime t) {
+  global_path_t m{};
+  m.utime = t;
+  m.frame = "NED";
+  m.status = global_path_t::OK;
+  m.num_points = points;
+  for (int i = 0; i < points; ++i) m.points.push_back({1.0 * i, 0.0, -30.0});
+  return m;
+}
+
+TEST_F(NodeTest, AMessageOverItsChannelsCapIsRejectedBeforeDecodingAndANormalOnePasses) {
+  Node node("planner_reader", lcm_, clock_);
+  std::vector<int32_t> got;
+  node.subscribe<global_path_t>(channels::kGlobalPath,
+                                [&](const global_path_t& m) { got.push_back(m.num_points); });
+  // 3,000 points are 72 KB, a valid path (validate takes up to 10,000) but
+  // over GLOBAL_PATH's 64 KiB; the shipped planner's longest was 4 KB.
+  const global_path_t big = path_of(3000, clock_.now());
+  ASSERT_GT(static_cast<size_t>(big.getEncodedSize()), max_message_bytes(channels::kGlobalPath));
+  ASSERT_EQ(validate(big), "");
+  node.publish(channels::kGlobalPath, big);
+  node.publish(channels::kGlobalPath, path_of(100, clock_.now()));
+  deliver();
+  ASSERT_EQ(got, std::vector<int32_t>{100});
+  EXPECT_EQ(node.counters().received, 1);
+  EXPECT_EQ(node.counters().rejected, 1);
+  EXPECT_NE(node.counters().last_reject_reason.find("GLOBAL_PATH: oversized: 72"),
+            std::string::npos)
+      << node.counters().last_reject_reason;
+  // Counted by kind, without its numbers.
+  EXPECT_EQ(node.counters().rejected_by_reason.count(
+                "GLOBAL_PATH: oversized: # bytes, over the channel's cap of #"),
+            1u);
+}
+
+TEST_F(NodeTest, OneByteOverTheCapAndATrailersRoomIsNotDecoded) {
+  // Garbage of the cap's size plus a trailer's is judged by the decoder
+  // (undecodable); one byte more never reaches it.
+  Node& node = subscribed();
+  const size_t limit = max_message_bytes(kChannel) + bus_auth::kTrailerBytes;
+  std::vector<uint8_t> junk(limit, 0x5a);
+  lcm_.publish(kChannel, junk.data(), static_cast<unsigned>(junk.size()));
+  junk.push_back(0x5a);
+  lcm_.publish(kChannel, junk.data(), static_cast<unsigned>(junk.size()));
+  deliver();
+  EXPECT_EQ(node.counters().rejected, 2);
+  EXPECT_EQ(node.counters().rejected_by_reason.count("TEST_NAV: undecodable (# bytes)"), 1u);
+  EXPECT_EQ(node.counters().rejected_by_reason.count(
+                "TEST_NAV: oversized: # bytes, over the channel's cap of #"),
+            1u);
+  EXPECT_TRUE(handled_.empty());
+}
+
+TEST(MessageCaps, EveryChannelHasOneAndHeartbeatsShareOne) {
+  EXPECT_EQ(max_message_bytes(channels::kNavState), 1024u);
+  EXPECT_EQ(max_message_bytes(channels::kObstacleGrid), 512u * 1024u);
+  EXPECT_EQ(max_message_bytes("HEARTBEAT_MAPPER"), max_message_bytes("HEARTBEAT_CONTROLLER"));
+  EXPECT_LT(max_message_bytes("HEARTBEAT_MAPPER"), max_message_bytes(channels::kLidarRaw));
+  // A channel the table does not name gets the largest cap.
+  EXPECT_EQ(max_message_bytes("SOMETHING_ELSE"), max_message_bytes(channels::kRefTraj));
+  EXPECT_EQ(max_received_bytes(channels::kNavState), 1024u + bus_auth::kTrailerBytes);
+  // Every channel's cap is above its largest message in the flights the
+  // table was measured on (message_caps.cpp).
+  EXPECT_GT(max_message_bytes(channels::kLidarRaw), 23220u);
+  EXPECT_GT(max_message_bytes(channels::kScanWorld), 16384u);
+  EXPECT_GT(max_message_bytes(channels::kObstacleGrid), 55764u);
+  EXPECT_GT(max_message_bytes(channels::kRefTraj), 203489u);
+  EXPECT_GT(max_message_bytes(channels::kGlobalPath), 4021u);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/link_model.hpp"
+#include "ofn/common/message_caps.hpp"
 
 namespace ofn {
 
@@ -65,18 +66,27 @@ class Node {
   const NodeCounters& counters() const { return counters_; }
   Utime now() const { return clock_.now(); }
 
-  /// Subscribes `handler` to `channel`. Every message is decoded, checked by
-  /// validate(Msg) (the caller includes ofn/common/validate/<message>.hpp
-  /// of each type it subscribes to) and for staleness; a bad one is counted, logged (rate
-  /// limited) and dropped, and the handler never sees it.
+  /// Subscribes `handler` to `channel`. Every message is checked against
+  /// the channel's size cap (ofn/common/message_caps.hpp) before anything
+  /// else, decoded, checked by validate(Msg) (the caller includes
+  /// ofn/common/validate/<message>.hpp of each type it subscribes to) and
+  /// for staleness; a bad one is counted, logged (rate limited) and
+  /// dropped, and the handler never sees it.
   template <class Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
                  SubscribeOptions options = {}) {
     auto sub = std::make_unique<Subscription>();
     sub->node = this;
     sub->channel = channel;
-    sub->deliver = [this, handler = std::move(handler), options,
-                    channel](const lcm::ReceiveBuffer* rbuf) {
+    sub->deliver = [this, handler = std::move(handler), options, channel,
+                    cap = max_message_bytes(channel)](const lcm::ReceiveBuffer* rbuf) {
+      // Room for a trailer: an open bus ignores one, an authenticated one
+      // requires it.
+      if (rbuf->data_size > cap + bus_auth::kTrailerBytes) {
+        reject(channel, "oversized: " + std::to_string(rbuf->data_size) +
+                            " bytes, over the channel's cap of " + std::to_string(cap));
+        return;
+      }
       size_t payload_size = rbuf->data_size;
       if (auth_) {
         const auto opened = auth_->open(channel, rbuf->data, rbuf->data_size);
