@@ -55,7 +55,7 @@ build: $(BUILD)/CMakeCache.txt
 # build); `make test` builds everything.
 FLIGHT_TARGETS := ofn_vehicle_sim ofn_controller ofn_mission_uplink ofn_flight_monitor \
   ofn_obstacle_injector ofn_sensor_interface ofn_mapper ofn_global_planner ofn_rh_optimizer \
-  ofn_flight_report ofn_viewer ofn_viewer_web ofn_bus_keygen
+  ofn_flight_report ofn_viewer ofn_viewer_web ofn_bus_keygen ofn_heartbeat_probe
 
 flight: $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target $(FLIGHT_TARGETS)

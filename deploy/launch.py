@@ -18,6 +18,13 @@ help, so the launcher ends the run at once instead.  Other exits of a
 restart: true service are restarted up to --max-restarts times in a row;
 a service that then runs --healthy-after seconds gets its budget back.
 
+A service that hangs does not exit.  For the processes whose table entry
+names how their heartbeats come (heartbeat: own or sim_clock), the launcher
+listens to the heartbeats (through ofn_heartbeat_probe, which prints one
+line per heartbeat; LCM has no Python bindings on Debian) and takes a
+process whose heartbeats stop for --hang-timeout seconds as hung (HangWatch):
+SIGTERM, SIGKILL after a grace, and its exit then goes the way of any other.
+
 Each service's output goes to the terminal prefixed with [name] and to
 <out>/<flight-stem>/<name>.log; the LCM traffic goes to
 <out>/<flight-stem>.lcm, whose path is also written to <out>/latest_log
@@ -76,6 +83,23 @@ BACKOFF_CAP_S = 8.0
 # Time each group of children gets to exit after SIGINT before SIGKILL.
 STOP_GRACE_S = 3.0
 
+# The hung-process watchdog (--hang-timeout, HangWatch). A service sends a
+# heartbeat once a second of its clock; five missed ones is a hang, not a
+# slow step (the longest planning step is a fraction of a second).
+DEFAULT_HANG_TIMEOUT_S = 5.0
+# A hung process gets SIGTERM, then SIGKILL this much later. A stopped
+# (SIGSTOP) process cannot act on SIGTERM; the SIGKILL ends it.
+HANG_KILL_GRACE_S = 2.0
+# A process not heard since its start gets this much longer: its start-up
+# (loading a scenario, a map) comes before its first heartbeat.
+HANG_START_ALLOWANCE_S = 10.0
+# The probe prints "tick" once a second; if it is not heard from for this
+# long the watchdog is deaf and judges nobody.
+PROBE_SILENCE_S = 3.0
+PROBE_PROGRAM = "ofn_heartbeat_probe"
+# How a process's heartbeats come (the table's heartbeat field).
+HEARTBEAT_KINDS = ("own", "sim_clock")
+
 # The ends_run process receives the same {timeout}; the launcher waits this
 # much longer so that the monitor's own timeout verdict wins the race against
 # the launcher's hard limit.
@@ -105,7 +129,8 @@ PLACEHOLDER_RE = re.compile(r"(?<!\$)\{([A-Za-z_][A-Za-z0-9_]*)\}")
 NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
 
 REQUIRED_FIELDS = {"name": str, "host": str, "core": int, "command": list}
-OPTIONAL_FIELDS = {"config": str, "restart": bool, "ends_run": bool, "priority": int}
+OPTIONAL_FIELDS = {"config": str, "restart": bool, "ends_run": bool, "priority": int,
+                   "heartbeat": str}
 
 
 class TableError(ofn_cli.InputError):
@@ -133,7 +158,7 @@ class ProcessSpec:
     """One validated entry of the process table."""
 
     def __init__(self, name, host, core, command, config=None, restart=False,
-                 ends_run=False, priority=None):
+                 ends_run=False, priority=None, heartbeat=None):
         self.name = name
         self.host = host
         self.core = core
@@ -142,6 +167,7 @@ class ProcessSpec:
         self.restart = restart
         self.ends_run = ends_run
         self.priority = priority
+        self.heartbeat = heartbeat    # one of HEARTBEAT_KINDS, or None: not watched
 
     def __repr__(self):
         return "ProcessSpec(%r, host=%r, core=%r)" % (self.name, self.host, self.core)
@@ -301,11 +327,16 @@ def load_table(path):
             raise TableError("%s: fields 'restart' and 'ends_run' cannot both be true "
                              "(the process that ends the run must not be restarted)" % where)
 
+        heartbeat = entry.get("heartbeat")
+        if heartbeat is not None and heartbeat not in HEARTBEAT_KINDS:
+            raise TableError("%s: field 'heartbeat' must be one of %s, got %r"
+                             % (where, ", ".join(HEARTBEAT_KINDS), heartbeat))
+
         config = entry.get("config")
         processes.append(ProcessSpec(
             name=name, host=host, core=core, command=command,
             config=resolve_repo_path(config) if config is not None else None,
-            restart=restart, ends_run=ends_run, priority=priority))
+            restart=restart, ends_run=ends_run, priority=priority, heartbeat=heartbeat))
 
     return ProcessTable(path, hosts, processes)
 
@@ -553,9 +584,12 @@ class Child:
     WAITING = "waiting"    # exited, restart scheduled at restart_at
     DONE = "done"          # exited for good (no restart, gave up, ends_run)
 
-    def __init__(self, name, argv, log_path, console, spec=None, file_only=None):
+    def __init__(self, name, argv, log_path, console, spec=None, file_only=None, line_sink=None):
         self.name = name
         self.file_only = file_only   # regex of lines kept out of the terminal
+        # Takes each output line first; a line it returns True for goes
+        # neither to the log nor to the terminal (the probe's heartbeats).
+        self.line_sink = line_sink
         self.argv = argv
         self.log_path = log_path
         self.console = console
@@ -571,6 +605,9 @@ class Child:
         self.gave_up = False
         self.last_returncode = None
         self.stopped_by_launcher = False
+        self.hangs = 0               # times the watchdog found it hung, in the whole run
+        self.killed_as_hung = False  # the current instance was found hung
+        self.hang_kill_at = None     # monotonic time of its SIGKILL, once found hung
 
     def alive(self):
         return self.proc is not None and self.proc.poll() is None
@@ -580,6 +617,8 @@ class Child:
         self.state = Child.RUNNING
         self.starts += 1
         self.started_at = time.monotonic()
+        self.killed_as_hung = False
+        self.hang_kill_at = None
         log = open(self.log_path, "ab")
         stamp = datetime.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
         header = "=== launcher %s: start #%d: %s\n" % (stamp, self.starts, shlex.join(self.argv))
@@ -609,6 +648,8 @@ class Child:
             for line in iter(stream.readline, b""):
                 if not line.endswith(b"\n"):
                     line += b"\n"
+                if self.line_sink is not None and self.line_sink(line):
+                    continue
                 log.write(line)
                 log.flush()
                 if self.file_only is None or not self.file_only.match(line):
@@ -759,6 +800,142 @@ class ResourceWatch:
         self.file.close()
 
 
+def heartbeat_channel(name):
+    """The heartbeat channel of a service: HEARTBEAT_<NAME> (heartbeat_channel
+    in services/common/src/node.cpp); the table name is the service's name."""
+    return "HEARTBEAT_" + name.upper()
+
+
+def process_group(pid):
+    """Process group of a local process, or None when there is none."""
+    try:
+        return os.getpgid(pid)
+    except (OSError, OverflowError):
+        return None
+
+
+class HangWatch:
+    """Which watched processes are hung, judged from the heartbeats the probe
+    (ofn_heartbeat_probe) hears on the bus. Pure but for a lock (the probe's
+    reader thread reports, the supervision loop asks): times are given,
+    monotonic seconds; heartbeat stamps are seconds of the sender's clock.
+
+    A heartbeat counts for a process when its pid is the process's or one
+    of its process group's (a wrapper that forks); the previous instance's,
+    still on the way after a restart, do not. A process is hung when none
+    has come for `timeout` seconds (since its start, plus `start_allowance`,
+    when none has come yet) and, by its kind:
+      own        its clock runs by itself (the wall clock; the simulation
+                 master's at `rtf` times real time, whose heartbeats come
+                 1/rtf s apart, so at least timeout/rtf s): silence is enough;
+      sim_clock  it follows SIM_CLOCK, and falls silent with every other
+                 follower when the simulation stops: hung only when the
+                 heartbeats of others heard since its last show the
+                 simulation ran `timeout` s of its time on without it.
+    Nobody is judged while the probe itself is not heard (its "tick" once a
+    second): a deaf watchdog must not kill what it cannot hear."""
+
+    class Entry:
+        def __init__(self, kind, group, now):
+            self.kind = kind
+            self.group = group        # the child's pid: its process group
+            self.started_at = now
+            self.last_at = None       # arrival of its last heartbeat
+            self.ref_stamp = None     # stamp the simulation's progress is measured from
+
+    def __init__(self, timeout, rtf=1.0, start_allowance=HANG_START_ALLOWANCE_S,
+                 probe_silence=PROBE_SILENCE_S, group_of=process_group):
+        if not timeout > 0 or not rtf > 0:
+            raise ValueError("HangWatch: timeout and rtf must be > 0")
+        self.timeout = timeout
+        self.rtf = rtf
+        self.start_allowance = start_allowance
+        self.probe_silence = probe_silence
+        self.group_of = group_of
+        self.lock = threading.Lock()
+        self.entries = {}   # heartbeat channel -> Entry
+        self.latest = {}    # heartbeat channel -> (arrival, stamp) of the last one heard
+        self.probe_at = None
+
+    def started(self, name, kind, pid, now):
+        """A (re)start of `name` as process `pid`: judged afresh from now."""
+        if kind not in HEARTBEAT_KINDS:
+            raise ValueError("HangWatch: unknown heartbeat kind %r" % kind)
+        with self.lock:
+            self.entries[heartbeat_channel(name)] = HangWatch.Entry(kind, pid, now)
+
+    def tick(self, now):
+        """The probe runs."""
+        with self.lock:
+            self.probe_at = now
+
+    def heard(self, channel, pid, stamp, now):
+        """A heartbeat the probe heard on `channel` from process `pid`,
+        stamped `stamp` (s)."""
+        with self.lock:
+            self.probe_at = now
+            self.latest[channel] = (now, stamp)
+            entry = self.entries.get(channel)
+            if entry is not None and (pid == entry.group or self.group_of(pid) == entry.group):
+                entry.last_at = now
+                entry.ref_stamp = stamp
+            # A process not heard yet measures the simulation from the first
+            # stamp of another heard since its start.
+            for other_channel, other in self.entries.items():
+                if other_channel != channel and other.ref_stamp is None:
+                    other.ref_stamp = stamp
+
+    def verdict(self, name, now):
+        """Why `name` counts as hung now, or None when it does not."""
+        channel = heartbeat_channel(name)
+        with self.lock:
+            entry = self.entries.get(channel)
+            if entry is None or self.probe_at is None or now - self.probe_at > self.probe_silence:
+                return None
+            since = entry.last_at if entry.last_at is not None else entry.started_at
+            needed = self.timeout * (max(1.0, 1.0 / self.rtf) if entry.kind == "own" else 1.0)
+            if entry.last_at is None:
+                needed += self.start_allowance
+            silent = now - since
+            if silent < needed:
+                return None
+            if entry.last_at is None:
+                why = "no heartbeat on %s in the %.1f s since its start" % (channel, silent)
+            else:
+                why = "no heartbeat on %s for %.1f s" % (channel, silent)
+            if entry.kind == "sim_clock":
+                fresh = [stamp for other, (at, stamp) in self.latest.items()
+                         if other != channel and at >= since]
+                if entry.ref_stamp is None or not fresh:
+                    return None
+                ran = max(fresh) - entry.ref_stamp
+                if ran < self.timeout:
+                    return None
+                why += " while the simulation ran %.1f s on" % ran
+            return why
+
+
+def probe_line_sink(hang_watch, clock=time.monotonic):
+    """The probe's output lines into `hang_watch`: "tick" and "heartbeat
+    <channel> <pid> <utime>" (True: consumed); anything else is left for the
+    probe's log (False)."""
+    def sink(line):
+        words = line.split()
+        if words == [b"tick"]:
+            hang_watch.tick(clock())
+            return True
+        if len(words) == 4 and words[0] == b"heartbeat":
+            try:
+                channel = words[1].decode("ascii")
+                pid, utime = int(words[2]), int(words[3])
+            except (UnicodeDecodeError, ValueError):
+                return False
+            hang_watch.heard(channel, pid, utime * 1e-6, clock())
+            return True
+        return False
+    return sink
+
+
 class RunState:
     """Flags set from signal handlers and read by the supervision loop."""
 
@@ -821,6 +998,12 @@ def build_parser():
                         help="a service that has run S seconds since its last restart gets its "
                              "full --max-restarts budget back; 0 = never (default: %s)"
                              % format_number(DEFAULT_HEALTHY_AFTER_S))
+    parser.add_argument("--hang-timeout", type=float, default=DEFAULT_HANG_TIMEOUT_S, metavar="S",
+                        help="a process with a heartbeat field in the table whose heartbeats "
+                             "stop for S seconds is hung: SIGTERM, SIGKILL after %s s, then "
+                             "restarted as if it had died; 0 = off (default: %s)"
+                             % (format_number(HANG_KILL_GRACE_S),
+                                format_number(DEFAULT_HANG_TIMEOUT_S)))
     return parser
 
 
@@ -837,6 +1020,8 @@ def parse_args(argv):
         errors.append("--max-restarts must be >= 0")
     if not args.healthy_after >= 0:
         errors.append("--healthy-after must be >= 0")
+    if not 0 <= args.hang_timeout < float("inf"):
+        errors.append("--hang-timeout must be >= 0 (0 = off)")
     for message in errors:
         parser.error(message)  # exits with code 2
     args.only = [n.strip() for n in args.only.split(",") if n.strip()] if args.only else None
@@ -862,11 +1047,14 @@ def unique_log_stem(log_dir):
 class Supervisor:
     """Starts the services in table order, restarts one that exits (with a
     back-off, within --max-restarts, the budget given back after
-    --healthy-after seconds up) and decides when the run ends: a signal, the
-    run limit, an ends_run service's exit, a configuration error, or no
-    service left. Sets end_reason and exit_code when it does."""
+    --healthy-after seconds up), ends one the hang watch finds hung (SIGTERM,
+    SIGKILL after HANG_KILL_GRACE_S; its exit then goes the same way) and
+    decides when the run ends: a signal, the run limit, an ends_run
+    service's exit, a configuration error, or no service left. Sets
+    end_reason and exit_code when it does."""
 
-    def __init__(self, services, env, console, state, max_restarts, healthy_after, timeout):
+    def __init__(self, services, env, console, state, max_restarts, healthy_after, timeout,
+                 hang_watch=None):
         self.services = services
         self.env = env
         self.say = console.say
@@ -874,14 +1062,25 @@ class Supervisor:
         self.max_restarts = max_restarts
         self.healthy_after = healthy_after
         self.timeout = timeout  # s, for the message when the run limit ends the run
+        self.hang_watch = hang_watch
         self.end_reason = None
         self.exit_code = 0
+
+    def _start(self, child, now):
+        """Starts a child; tells the hang watch of a watched one. False if it
+        could not be executed."""
+        if not child.start(self.env):
+            return False
+        if self.hang_watch is not None and child.spec.heartbeat:
+            self.hang_watch.started(child.name, child.spec.heartbeat, child.proc.pid, now)
+        return True
 
     def start_all(self):
         for child in self.services:
             if self.state.stop_signal is not None:
                 return
-            if not child.start(self.env) and self._ends(self.handle_exit(child, time.monotonic())):
+            now = time.monotonic()
+            if not self._start(child, now) and self._ends(self.handle_exit(child, now)):
                 return
 
     def poll(self, now, deadline):
@@ -902,9 +1101,11 @@ class Supervisor:
                 self.reset_if_healthy(child, now)
             if child.state == Child.RUNNING and not child.alive():
                 outcome = self.handle_exit(child, now)
+            elif child.state == Child.RUNNING:
+                self.end_if_hung(child, now)
             elif child.state == Child.WAITING and now >= child.restart_at:
                 child.restart_at = None
-                if not child.start(self.env):
+                if not self._start(child, now):
                     outcome = self.handle_exit(child, now)
             if self._ends(outcome):
                 return True
@@ -935,6 +1136,28 @@ class Supervisor:
                      % (child.name, format_number(self.healthy_after), self.max_restarts))
             child.restarts = 0
 
+    def end_if_hung(self, child, now):
+        """SIGTERM a live child the hang watch finds hung; SIGKILL it
+        HANG_KILL_GRACE_S later if it is still there."""
+        if self.hang_watch is None or not child.spec.heartbeat:
+            return
+        if child.hang_kill_at is not None:
+            if now >= child.hang_kill_at:
+                self.say("%s still there %g s after SIGTERM; sending SIGKILL"
+                         % (child.name, HANG_KILL_GRACE_S))
+                child.signal_group(signal.SIGKILL)
+                child.hang_kill_at = float("inf")  # sent; its exit is handled as any other
+            return
+        why = self.hang_watch.verdict(child.name, now)
+        if why is None:
+            return
+        child.hangs += 1
+        child.killed_as_hung = True
+        child.hang_kill_at = now + HANG_KILL_GRACE_S
+        self.say("%s is HUNG (%s): SIGTERM, SIGKILL in %g s if it stays"
+                 % (child.name, why, HANG_KILL_GRACE_S))
+        child.signal_group(signal.SIGTERM)
+
     def handle_exit(self, child, now):
         """Decide what a child's exit means; returns (end_reason, exit_code) or None."""
         if child.proc is None:
@@ -943,6 +1166,13 @@ class Supervisor:
             child.finish_output()
             child.last_returncode = child.proc.returncode
             code, text = describe_exit(child.proc.returncode)
+        if child.killed_as_hung:
+            text += " after it hung"
+            if child.spec.ends_run:
+                # Whatever it returned on SIGTERM is not a verdict.
+                child.state = Child.DONE
+                return ("%s %s; it ends the run (exit code %d)"
+                        % (child.name, text, EXIT_LAUNCHER_FAILURE)), EXIT_LAUNCHER_FAILURE
         if code == EXIT_SERVICE_CONFIG_ERROR:
             # Restarting cannot fix a configuration or usage error, and
             # the flight cannot go on without the service: stop now.
@@ -975,8 +1205,10 @@ class Supervisor:
 
 def check_inputs(args, table_path, scenario, values):
     """Everything checked once, before anything starts: the table, the
-    selection, the scenario, each service's files, the keyring, lcm-logger.
-    Returns (specs, lcm-logger path or None); raises TableError."""
+    selection, the scenario, each service's files, the keyring, lcm-logger
+    and, when a selected process is watched for hangs, the heartbeat probe.
+    Returns (specs, lcm-logger path or None, probe path or None); raises
+    TableError."""
     table = load_table(table_path)
     specs = select_processes(table, args.only, args.host)
     check_yaml_file(scenario, "--scenario", allow_empty=False)
@@ -988,7 +1220,13 @@ def check_inputs(args, table_path, scenario, values):
         logger_exe = shutil.which("lcm-logger")
         if logger_exe is None:
             raise TableError("lcm-logger not found (apt-get install liblcm-bin), or pass --no-record")
-    return specs, logger_exe
+    probe_exe = None
+    if args.hang_timeout > 0 and any(s.heartbeat for s in specs):
+        probe_exe = os.path.join(values["bin"], PROBE_PROGRAM)
+        if not (os.path.isfile(probe_exe) and os.access(probe_exe, os.X_OK)):
+            raise TableError("--hang-timeout: %s not found or not executable - build first: "
+                             "make build (or --hang-timeout 0: no hang watch)" % probe_exe)
+    return specs, logger_exe, probe_exe
 
 
 def install_signal_handlers(state):
@@ -1043,10 +1281,23 @@ def start_logger(logger, lcm_log, log_dir, console, env):
     return True
 
 
-def watch_run(supervisor, deadline, resources, logger, say):
+def probe_child(probe_exe, lcm_url, bus_keys, hang_watch, service_log_dir, orphan_guard,
+                line_buffered, console):
+    """The heartbeat probe: its heartbeat lines go to `hang_watch`, anything
+    else to its log and the terminal."""
+    argv = orphan_guard + line_buffered + [probe_exe, "--lcm-url", lcm_url]
+    if bus_keys:
+        argv += ["--bus-keys", bus_keys]
+    return Child(PROBE_PROGRAM, argv, os.path.join(service_log_dir, PROBE_PROGRAM + ".log"),
+                 console, line_sink=probe_line_sink(hang_watch))
+
+
+def watch_run(supervisor, deadline, resources, logger, say, probe=None):
     """Polls until the supervisor ends the run: samples each service's
-    memory and CPU, and warns once if lcm-logger dies."""
+    memory and CPU, and warns once if lcm-logger or the heartbeat probe
+    dies."""
     logger_warned = False
+    probe_warned = False
     while supervisor.end_reason is None:
         now = time.monotonic()
         if supervisor.poll(now, deadline):
@@ -1057,6 +1308,11 @@ def watch_run(supervisor, deadline, resources, logger, say):
             say("WARNING: lcm-logger %s; the rest of this flight is NOT being recorded"
                 % describe_exit(logger.proc.returncode)[1])
             logger_warned = True
+        if probe is not None and not probe_warned and not probe.alive():
+            probe.finish_output()
+            say("WARNING: %s %s; hung services are no longer found"
+                % (PROBE_PROGRAM, describe_exit(probe.proc.returncode)[1]))
+            probe_warned = True
         if supervisor.all_done():
             return
         time.sleep(POLL_INTERVAL_S)
@@ -1086,7 +1342,7 @@ def main(argv=None):
     }
 
     try:
-        specs, logger_exe = check_inputs(args, table_path, scenario, values)
+        specs, logger_exe, probe_exe = check_inputs(args, table_path, scenario, values)
     except TableError as e:
         sys.stderr.write("launch.py: error: %s\n" % e)
         return EXIT_BAD_INPUT
@@ -1142,8 +1398,19 @@ def main(argv=None):
     logger = None
     lcm_log = os.path.join(log_dir, stem + ".lcm")
     resources = None
+    hang_watch = None
+    probe = None
+    if probe_exe is not None:
+        hang_watch = HangWatch(args.hang_timeout, args.rtf)
+        probe = probe_child(probe_exe, args.lcm_url, values["bus_keys"], hang_watch,
+                            service_log_dir, orphan_guard, line_buffered, console)
+        say("hang watch: %s, %s s without a heartbeat (--hang-timeout)"
+            % (", ".join("%s (%s)" % (s.name, s.heartbeat) for s in specs if s.heartbeat),
+               format_number(args.hang_timeout)))
+    elif args.hang_timeout == 0:
+        note("no hang watch (--hang-timeout 0)")
     supervisor = Supervisor(services, env, console, state, args.max_restarts, args.healthy_after,
-                            args.timeout)
+                            args.timeout, hang_watch)
     try:
         if logger_exe is not None:
             logger = logger_child(logger_exe, args.lcm_url, lcm_log, service_log_dir, orphan_guard,
@@ -1154,17 +1421,23 @@ def main(argv=None):
             note("not recording LCM traffic (--no-record)")
         say("service logs in %s/" % service_log_dir)
         resources = ResourceWatch(os.path.join(service_log_dir, "resources.csv"))
+        if probe is not None and not probe.start(env):
+            say("WARNING: %s could not be started; hung services will not be found"
+                % PROBE_PROGRAM)
 
         supervisor.start_all()
         deadline = time.monotonic() + run_limit if run_limit is not None else None
-        watch_run(supervisor, deadline, resources, logger, say)
+        watch_run(supervisor, deadline, resources, logger, say, probe)
         say(supervisor.end_reason)
     finally:
         # Services first (reverse start order, so consumers go before the
-        # producers they depend on), the logger last so it captures their
-        # final messages.  Always runs, so no child outlives the launcher.
+        # producers they depend on), then the probe, the logger last so it
+        # captures their final messages.  Always runs, so no child outlives
+        # the launcher.
         state.stopping = True
         stop_children(list(reversed(services)), console, state)
+        if probe is not None:
+            stop_children([probe], console, state)
         if logger is not None:
             stop_children([logger], console, state)
             try:
@@ -1200,6 +1473,8 @@ def print_summary(services, console, max_restarts, resources=None):
             restarts = "%d/%d" % (child.restarts, max_restarts)
             if child.total_restarts != child.restarts:
                 restarts += " (%d in all)" % child.total_restarts
+        if child.hangs:
+            restarts += ", hung %d" % child.hangs
         usage = resources.describe(child.name) if resources is not None else ""
         rows.append((child.name, child.spec.host, restarts, final, usage))
     width = max(len(r[0]) for r in rows)

@@ -719,5 +719,320 @@ class SupervisionTest(LauncherTestCase):
         self.fail("child process %d outlived the launcher" % pid)
 
 
+
+class HangWatchTest(unittest.TestCase):
+    """The watchdog's decisions, with given times and heartbeats."""
+
+    def watch(self, timeout=5.0, rtf=1.0, groups=None):
+        groups = groups or {}
+        watch = launch.HangWatch(timeout, rtf, start_allowance=10.0, probe_silence=3.0,
+                                 group_of=lambda pid: groups.get(pid))
+        return watch
+
+    @staticmethod
+    def beat(watch, name, pid, stamp, now):
+        watch.heard(launch.heartbeat_channel(name), pid, stamp, now)
+
+    def test_an_own_clock_process_silent_for_the_timeout_is_hung(self):
+        watch = self.watch()
+        watch.started("vehicle_sim", "own", 100, 0.0)
+        for t in range(11):
+            self.beat(watch, "vehicle_sim", 100, float(t), float(t))
+        for t in range(11, 16):
+            watch.tick(float(t))
+        self.assertIsNone(watch.verdict("vehicle_sim", 14.9))
+        why = watch.verdict("vehicle_sim", 15.0)
+        self.assertEqual(why, "no heartbeat on HEARTBEAT_VEHICLE_SIM for 5.0 s")
+
+    def test_a_slow_simulation_master_gets_its_heartbeat_period(self):
+        # At half real time its heartbeats come 2 s apart: 10 s of silence
+        # is 5 s of its time.
+        watch = self.watch(rtf=0.5)
+        watch.started("vehicle_sim", "own", 100, 0.0)
+        self.beat(watch, "vehicle_sim", 100, 0.0, 0.0)
+        for t in range(1, 11):
+            watch.tick(float(t))
+        self.assertIsNone(watch.verdict("vehicle_sim", 9.9))
+        self.assertIsNotNone(watch.verdict("vehicle_sim", 10.0))
+
+    def test_followers_are_not_hung_while_the_simulation_stands_still(self):
+        # vehicle_sim stopped: every follower falls silent with it. Only the
+        # master counts as hung; the followers would all be killed otherwise.
+        watch = self.watch()
+        watch.started("vehicle_sim", "own", 100, 0.0)
+        watch.started("mapper", "sim_clock", 200, 0.0)
+        for t in range(6):
+            self.beat(watch, "vehicle_sim", 100, float(t), float(t))
+            self.beat(watch, "mapper", 200, float(t), float(t) + 0.01)
+        for t in range(6, 60):
+            watch.tick(float(t))
+        self.assertIsNotNone(watch.verdict("vehicle_sim", 59.0))
+        self.assertIsNone(watch.verdict("mapper", 59.0))
+
+    def test_a_follower_silent_while_the_simulation_runs_on_is_hung(self):
+        watch = self.watch()
+        watch.started("controller", "sim_clock", 300, 0.0)
+        watch.started("mapper", "sim_clock", 200, 0.0)
+        for t in range(4):
+            self.beat(watch, "mapper", 200, float(t), float(t))
+            self.beat(watch, "controller", 300, float(t), float(t))
+        # The mapper stops at 3 s; the controller's heartbeats go on.
+        verdicts = {}
+        for t in range(4, 12):
+            self.beat(watch, "controller", 300, float(t), float(t))
+            verdicts[t] = watch.verdict("mapper", float(t))
+            self.assertIsNone(watch.verdict("controller", float(t)))
+        self.assertEqual([t for t, v in verdicts.items() if v is None], [4, 5, 6, 7])
+        self.assertEqual(verdicts[8], "no heartbeat on HEARTBEAT_MAPPER for 5.0 s while the "
+                                      "simulation ran 5.0 s on")
+
+    def test_a_follower_at_a_fast_simulation_waits_for_the_wall_time_too(self):
+        # At 4x real time 5 s of simulation pass in 1.25 s: a step that
+        # blocks 1.5 s is no hang.
+        watch = self.watch(rtf=4.0)
+        watch.started("controller", "sim_clock", 300, 0.0)
+        watch.started("mapper", "sim_clock", 200, 0.0)
+        self.beat(watch, "mapper", 200, 10.0, 0.0)
+        hung_at = None
+        for i in range(1, 40):
+            self.beat(watch, "controller", 300, 10.0 + i, i * 0.25)
+            if hung_at is None and watch.verdict("mapper", i * 0.25) is not None:
+                hung_at = i * 0.25
+        # 5 s of simulation were over at 1.25 s; 5 s of wall time at 5 s.
+        self.assertEqual(hung_at, 5.0)
+
+    def test_heartbeats_of_another_process_do_not_count_those_of_its_group_do(self):
+        # Pid 555 is the previous instance (still on the way after a
+        # restart); pid 201 a process in the new instance's group 200.
+        watch = self.watch(groups={201: 200, 555: 555})
+        watch.started("mapper", "own", 200, 0.0)
+        for t in range(1, 30):
+            self.beat(watch, "mapper", 555, float(t), float(t))
+        self.assertIsNotNone(watch.verdict("mapper", 15.0))
+        watch.started("mapper", "own", 200, 20.0)
+        for t in range(20, 30):
+            self.beat(watch, "mapper", 201, float(t), float(t))
+        for t in range(30, 35):
+            watch.tick(float(t))
+        self.assertIsNone(watch.verdict("mapper", 33.9))
+        self.assertIsNotNone(watch.verdict("mapper", 34.0))
+
+    def test_a_process_never_heard_gets_the_start_allowance(self):
+        watch = self.watch()
+        watch.started("mapper", "own", 200, 0.0)
+        for t in range(1, 20):
+            watch.tick(float(t))
+        self.assertIsNone(watch.verdict("mapper", 14.9))
+        self.assertEqual(watch.verdict("mapper", 15.0),
+                         "no heartbeat on HEARTBEAT_MAPPER in the 15.0 s since its start")
+
+    def test_a_follower_never_heard_is_hung_once_the_simulation_ran_on(self):
+        watch = self.watch()
+        watch.started("vehicle_sim", "own", 100, 0.0)
+        watch.started("mapper", "sim_clock", 200, 0.0)
+        # Nothing runs for 20 s (the simulator loads), then it does.
+        for t in range(20):
+            watch.tick(float(t))
+        self.assertIsNone(watch.verdict("mapper", 19.0))
+        hung_at = None
+        for t in range(20, 30):
+            self.beat(watch, "vehicle_sim", 100, float(t - 20), float(t))
+            if hung_at is None and watch.verdict("mapper", float(t)) is not None:
+                hung_at = t
+        # From the first stamp heard after its start (0 s at 20 s): 5 s of it.
+        self.assertEqual(hung_at, 25)
+
+    def test_a_deaf_watch_judges_nobody(self):
+        watch = self.watch()
+        watch.started("vehicle_sim", "own", 100, 0.0)
+        self.beat(watch, "vehicle_sim", 100, 0.0, 0.0)
+        watch.tick(10.0)
+        self.assertIsNotNone(watch.verdict("vehicle_sim", 12.0))
+        # The probe's last tick 3.5 s ago: it may be the one that hangs.
+        self.assertIsNone(watch.verdict("vehicle_sim", 13.5))
+        self.assertIsNone(watch.verdict("unknown", 12.0))
+
+    def test_bad_arguments_are_refused(self):
+        with self.assertRaises(ValueError):
+            launch.HangWatch(0.0)
+        with self.assertRaises(ValueError):
+            launch.HangWatch(5.0).started("x", "wall", 1, 0.0)
+
+    def test_probe_lines(self):
+        watch = self.watch()
+        watch.started("mapper", "own", 200, 0.0)
+        sink = launch.probe_line_sink(watch, clock=lambda: 1.0)
+        self.assertTrue(sink(b"tick\n"))
+        self.assertTrue(sink(b"heartbeat HEARTBEAT_MAPPER 200 2500000\n"))
+        self.assertFalse(sink(b"heartbeat HEARTBEAT_MAPPER x 1\n"))
+        self.assertFalse(sink(b"refused 1 heartbeat message(s) so far; the last: ...\n"))
+        # Heard at 1.0 s: hung 5 s later.
+        watch.tick(6.0)
+        self.assertIsNone(watch.verdict("mapper", 5.9))
+        self.assertIsNotNone(watch.verdict("mapper", 6.0))
+
+    def test_the_heartbeat_channel_is_the_services(self):
+        self.assertEqual(launch.heartbeat_channel("rh_optimizer"), "HEARTBEAT_RH_OPTIMIZER")
+
+
+class HangSupervisionTest(LauncherTestCase):
+    """The launcher with a stand-in probe that reports what a script says."""
+
+    def fake_probe(self, script_body):
+        bin_dir = os.path.join(self.dir, "bin")
+        os.makedirs(bin_dir, exist_ok=True)
+        path = os.path.join(bin_dir, "ofn_heartbeat_probe")
+        with open(path, "w") as f:
+            f.write("#!/bin/sh\n" + textwrap.dedent(script_body))
+        os.chmod(path, 0o755)
+        return bin_dir
+
+    def test_project_table_watches_every_service_but_the_monitor(self):
+        table = launch.load_table(REAL_TABLE)
+        kinds = {p.name: p.heartbeat for p in table.processes}
+        self.assertEqual(kinds.pop("vehicle_sim"), "own")
+        self.assertIsNone(kinds.pop("flight_monitor"))
+        self.assertEqual(set(kinds.values()), {"sim_clock"})
+
+    def test_unknown_heartbeat_kind_is_named(self):
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: worker
+                host: gcs
+                core: 0
+                command: ["sleep", "1"]
+                heartbeat: wall
+            """)
+        with self.assertRaisesRegex(launch.TableError,
+                                    r"worker.*field 'heartbeat' must be one of own, sim_clock"):
+            launch.load_table(table)
+
+    def test_a_watched_table_needs_the_probe_unless_the_watch_is_off(self):
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: worker
+                host: gcs
+                core: 0
+                command: ["sleep", "0.5"]
+                heartbeat: own
+                ends_run: true
+            """)
+        result = self.run_launcher(table, "--bin", self.dir)
+        self.assertEqual(result.returncode, 2, result.stdout + result.stderr)
+        self.assertIn("--hang-timeout: %s/ofn_heartbeat_probe not found" % self.dir, result.stderr)
+        self.assertIn("--hang-timeout 0", result.stderr)
+        result = self.run_launcher(table, "--bin", self.dir, "--hang-timeout", "0")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn("no hang watch (--hang-timeout 0)", result.stdout)
+
+    def test_negative_hang_timeout_is_a_usage_error(self):
+        result = self.run_launcher(self.write_table(TableValidationTest.GOOD_TABLE),
+                                   "--hang-timeout", "-1")
+        self.assertEqual(result.returncode, 2)
+        self.assertIn("--hang-timeout must be >= 0", result.stderr)
+
+    def test_a_silent_process_is_killed_as_hung_and_restarted(self):
+        # The stand-in service ignores SIGTERM (so the SIGKILL is needed) and
+        # writes its pid; the stand-in probe reports its heartbeats for the
+        # first 1.5 s of each start, then only ticks. A process without a
+        # heartbeat field beside it is never touched.
+        pid_file = os.path.join(self.dir, "worker.pid")
+        bin_dir = self.fake_probe("""\
+            i=0
+            while :; do
+              echo tick
+              pid=$(cat %s 2>/dev/null)
+              started=$(stat -c %%Y %s 2>/dev/null || echo 0)
+              if [ -n "$pid" ] && [ $(( $(date +%%s) - started )) -le 1 ]; then
+                echo "heartbeat HEARTBEAT_WORKER $pid $i"
+              fi
+              i=$((i + 250000))
+              sleep 0.25
+            done
+            """ % (pid_file, pid_file))
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: worker
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "trap '' TERM; echo $$ > %s; exec sleep 60"]
+                restart: true
+                heartbeat: own
+              - name: quiet
+                host: gcs
+                core: 0
+                command: ["sleep", "60"]
+                restart: true
+            """ % pid_file)
+        start = time.monotonic()
+        result = self.run_launcher(table, "--bin", bin_dir, "--hang-timeout", "1.5",
+                                   "--timeout", "12")
+        out = result.stdout
+        self.assertEqual(result.returncode, 3, out + result.stderr)
+        self.assertLess(time.monotonic() - start, 40)
+        self.assertIn("hang watch: worker (own), 1.5 s without a heartbeat", out)
+        hung = re.findall(r"worker is HUNG \(no heartbeat on HEARTBEAT_WORKER for (\S+) s\)", out)
+        self.assertGreaterEqual(len(hung), 1, out)
+        self.assertIn("worker still there 2 s after SIGTERM; sending SIGKILL", out)
+        self.assertRegex(out, r"worker exited with code 137 \(signal SIGKILL\) after it hung; "
+                              r"restarting in 0\.5 s \(restart 1/5\)")
+        self.assertRegex(out, r"worker\s+gcs\s+restarts \d/5( \(\d in all\))?, hung %d\s"
+                         % len(hung))
+        self.assertNotIn("quiet is HUNG", out)
+        self.assertRegex(out, r"quiet\s+gcs\s+restarts 0/5\s+.*stopped by launcher")
+        # The probe's lines are the watch's, not the log's.
+        runs = [d for d in os.listdir(self.log_dir) if d.startswith("flight-")]
+        with open(os.path.join(self.log_dir, runs[0], "ofn_heartbeat_probe.log")) as f:
+            self.assertNotIn("heartbeat HEARTBEAT_WORKER", f.read())
+
+    def test_a_probe_that_dies_is_reported_and_nobody_is_killed(self):
+        bin_dir = self.fake_probe("echo tick; exit 1\n")
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: worker
+                host: gcs
+                core: 0
+                command: ["sleep", "60"]
+                restart: true
+                heartbeat: own
+            """)
+        result = self.run_launcher(table, "--bin", bin_dir, "--hang-timeout", "0.5",
+                                   "--timeout", "5")
+        out = result.stdout
+        self.assertEqual(result.returncode, 3, out + result.stderr)
+        self.assertIn("WARNING: ofn_heartbeat_probe exited with code 1; hung services are no "
+                      "longer found", out)
+        self.assertNotIn("is HUNG", out)
+
+    def test_a_hung_process_that_ends_the_run_ends_it_as_a_failure(self):
+        bin_dir = self.fake_probe("while :; do echo tick; sleep 0.2; done\n")
+        table = self.write_table("""\
+            hosts:
+              gcs: {cores: [0]}
+            processes:
+              - name: monitor
+                host: gcs
+                core: 0
+                command: ["/bin/sh", "-c", "trap 'exit 0' TERM; while :; do sleep 0.1; done"]
+                ends_run: true
+                heartbeat: own
+            """)
+        result = self.run_launcher(table, "--bin", bin_dir, "--hang-timeout", "0.5",
+                                   "--timeout", "60")
+        out = result.stdout
+        # It exits 0 on SIGTERM; that is no verdict.
+        self.assertEqual(result.returncode, 1, out + result.stderr)
+        self.assertIn("monitor exited with code 0 after it hung; it ends the run (exit code 1)",
+                      out)
+
+
 if __name__ == "__main__":
     unittest.main()
