@@ -19,6 +19,7 @@
 
 #include "ofn/bus_auth/authenticator.hpp"
 #include "ofn/common/clock.hpp"
+#include "ofn/common/command_line.hpp"
 #include "ofn/common/service_main.hpp"
 #include "ofn/tools/heartbeat_probe.hpp"
 
@@ -35,8 +36,8 @@ struct Listener {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ofn heartbeat probe: prints every heartbeat on the bus, for the launcher"};
-  app.failure_message(CLI::FailureMessage::help);
+  ofn::CommandLine app{"ofn_heartbeat_probe",
+                       "ofn heartbeat probe: prints every heartbeat on the bus, for the launcher"};
   std::string lcm_url, bus_keys;
   app.add_option("--lcm-url", lcm_url,
                  "LCM URL (default: $LCM_DEFAULT_URL or " + std::string(ofn::kDefaultLcmUrl) + ")");
