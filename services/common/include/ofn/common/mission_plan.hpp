@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "ofn/common/frames.hpp"
-#include "ofn/common/scenario.hpp"
+#include "ofn/common/mission_types.hpp"
 #include "ofn/mission_t.hpp"
 
 namespace ofn {
