@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ofn/common/config.hpp"
+#include "ofn/common/leg_tracker.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/control_status_t.hpp"

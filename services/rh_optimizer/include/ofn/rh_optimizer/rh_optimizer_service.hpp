@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "ofn/common/config.hpp"
+#include "ofn/common/leg_tracker.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/warning_streak.hpp"

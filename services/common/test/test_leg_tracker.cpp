@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "ofn/common/mission_plan.hpp"
+#include "ofn/common/leg_tracker.hpp"
 
 namespace ofn {
 namespace {
