@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "ofn/common/channels.hpp"
 #include "ofn/common/message_checks.hpp"
+#include "ofn/common/mission_plan.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
 #include "ofn/common/validate/control_status.hpp"
 #include "ofn/common/validate/global_path.hpp"
@@ -16,8 +14,6 @@
 #include "ofn/common/validate/nav_state.hpp"
 #include "ofn/common/validate/obstacle_grid.hpp"
 #include "ofn/common/validate/scan_world.hpp"
-#include "ofn/rh_optimizer/start_state.hpp"
-#include "ofn/rh_optimizer/step_problem.hpp"
 
 namespace ofn::rh {
 namespace {
@@ -28,36 +24,64 @@ Vec3 vec3_in(YamlReader& r, const std::string& key, const Vec3& fallback, double
   return Vec3(v[0], v[1], v[2]);
 }
 
-int8_t stats_status(StepMode mode) {
-  switch (mode) {
-    case StepMode::kSolved:
+int8_t stats_code(StatsStatus status) {
+  switch (status) {
+    case StatsStatus::kSolved:
       return solver_stats_t::SOLVED;
-    case StepMode::kKeptPrevious:
+    case StatsStatus::kKeptPrevious:
       return solver_stats_t::KEPT_PREVIOUS;
-    case StepMode::kBraking:
+    case StatsStatus::kBraking:
+      return solver_stats_t::BRAKING;
+    case StatsStatus::kDeferred:
+      return solver_stats_t::DEFERRED;
+    case StatsStatus::kLookingAround:
+      return solver_stats_t::LOOKING_AROUND;
+    case StatsStatus::kNoRoute:
+      return solver_stats_t::NO_ROUTE;
+    case StatsStatus::kNotRun:
       break;
   }
-  return solver_stats_t::BRAKING;
+  return solver_stats_t::NOT_RUN;
 }
 
-int8_t traj_mode(StepMode mode) {
+int8_t traj_mode(PlanMode mode) {
   switch (mode) {
-    case StepMode::kSolved:
+    case PlanMode::kAvoidance:
       return ref_traj_t::AVOIDANCE;
-    case StepMode::kKeptPrevious:
+    case PlanMode::kPrevious:
       return ref_traj_t::PREVIOUS;
-    case StepMode::kBraking:
+    case PlanMode::kLookAround:
+      return ref_traj_t::LOOK_AROUND;
+    case PlanMode::kLookAroundLeft:
+      return ref_traj_t::LOOK_AROUND_LEFT;
+    case PlanMode::kBraking:
       break;
   }
   return ref_traj_t::BRAKING;
 }
 
-double distance_to_polyline(const std::vector<Vec3>& line, const Vec3& p) {
-  double best = std::numeric_limits<double>::infinity();
-  if (line.size() == 1) return (line[0] - p).norm();
-  for (size_t i = 1; i < line.size(); ++i)
-    best = std::min(best, distance_to_segment(p, line[i - 1], line[i]));
-  return best;
+SupervisorSettings supervisor_settings(const RhOptimizerServiceConfig& c) {
+  SupervisorSettings s;
+  s.rate = c.rate;
+  s.nav_max_age = c.nav_max_age;
+  s.grid_max_age = c.grid_max_age;
+  s.path_max_age = c.path_max_age;
+  s.route_change_distance = c.route_change_distance;
+  s.defer_margin = c.defer_margin;
+  s.start.planned_initial_state = c.planned_initial_state;
+  s.start.replan_position_error = c.replan_position_error;
+  s.start.replan_velocity_error = c.replan_velocity_error;
+  s.start.planned_initial_acceleration = c.planned_initial_acceleration;
+  s.start.stop_recapture_error = c.stop_recapture_error;
+  s.optimizer = c.optimizer;
+  s.fallback = c.fallback;
+  s.commit = c.commit;
+  s.avoidance = c.avoidance;
+  s.recovery = c.recovery;
+  s.passages = c.passages;
+  s.scan_supply = c.scan_supply;
+  s.tracking_tube = c.tracking_tube;
+  return s;
 }
 
 }  // namespace
@@ -259,29 +283,13 @@ ref_traj_t trajectory_message(const BsplineTrajectory& trajectory, Utime t0, int
   return m;
 }
 
-double route_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const Vec3& from,
-                        double horizon) {
-  if (a.empty() || b.empty()) return std::numeric_limits<double>::infinity();
-  double worst = 0;
-  for (const auto& p : b) {
-    if ((p - from).norm() > horizon) continue;
-    worst = std::max(worst, distance_to_polyline(a, p));
-  }
-  return worst;
-}
-
 RhOptimizerService::RhOptimizerService(lcm::LCM& lcm, const Clock& clock,
                                        RhOptimizerServiceConfig config)
     : node_("rh_optimizer", lcm, clock),
       config_(std::move(config)),
-      planner_(config_.optimizer, config_.fallback, config_.commit),
-      switch_(config_.avoidance),
+      supervisor_(supervisor_settings(config_)),
       visibility_(1.0, config_.visibility_band),
-      scan_supply_(config_.scan_supply),
-      tube_(config_.tracking_tube),
-      field_(config_.field),
-      recovery_(config_.recovery),
-      passages_(config_.passages.max_passages) {
+      field_(config_.field) {
   node_.subscribe<nav_state_t>(
       channels::kNavState, [this](const nav_state_t& m) { on_nav(m); },
       SubscribeOptions{config_.nav_max_age, 0.5});
@@ -317,13 +325,9 @@ void RhOptimizerService::on_mission(const mission_t& m) {
     return;
   }
   mission_ = m;
-  legs_.clear();
-  active_leg_ = -1;
-  restart_planning();
-  switch_.reset();
+  supervisor_.start_mission(m.mission_id, waypoints_from(m), limits_from(m.limits));
   visibility_.clear();
   shadows_.clear();
-  passages_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
                    m.mission_id, m.name, m.limits.clearance, config_.optimizer.clearance_margin,
                    m.limits.max_accel);
@@ -339,64 +343,39 @@ void RhOptimizerService::on_grid(const obstacle_grid_t& m) {
 }
 
 void RhOptimizerService::on_global_path(const global_path_t& m) {
-  // What the planner says decides a dead end's recovery: a route along the
-  // leg (also one only too sharp to fly: NO_PATH with points), one that
-  // turns back, or none.
-  route_kind_utime_ = m.utime;
+  // A route along the leg (also one only too sharp to fly: NO_PATH with
+  // points), one that turns back, or none.
+  RouteInput route;
+  route.utime = m.utime;
   if (m.status == global_path_t::OK || (m.status == global_path_t::NO_PATH && m.points.size() >= 2))
-    route_kind_ = RouteKind::kForward;
+    route.kind = RouteKind::kForward;
   else if (m.status == global_path_t::BACKTRACK && m.points.size() >= 2)
-    route_kind_ = RouteKind::kBacktrack;
+    route.kind = RouteKind::kBacktrack;
   else
-    route_kind_ = RouteKind::kNoPath;
-  recovery_route_.clear();
-  if (route_kind_ != RouteKind::kNoPath)
-    for (const auto& p : m.points) recovery_route_.emplace_back(p[0], p[1], p[2]);
+    route.kind = RouteKind::kNoPath;
+  route.points.reserve(m.points.size());
+  for (const auto& p : m.points) route.points.emplace_back(p[0], p[1], p[2]);
   // NO_PATH may still carry the shortest collision-free route (too sharp to
   // fly as it is): a good guess of which way round.
-  if ((m.status != global_path_t::OK && m.status != global_path_t::NO_PATH) || m.points.size() < 2)
-    return;
-  std::vector<Vec3> points;
-  points.reserve(m.points.size());
-  for (const auto& p : m.points) points.emplace_back(p[0], p[1], p[2]);
-  const Vec3 from = nav_ ? to_vec3(nav_->position) : points.front();
-  const double horizon = mission_ ? mission_->limits.sensor_range : 60.0;
-  // The planner re-publishes every second; only a different way round is a
-  // new route (and a reason to drop the warm start).
-  if (route_.empty() ||
-      route_difference(route_, points, from, horizon) > config_.route_change_distance) {
-    route_changed_ = true;
-    if (!route_.empty()) node_.log().info("new global route ({} points)", points.size());
-  }
-  route_ = std::move(points);
-  route_utime_ = m.utime;
+  route.guess =
+      (m.status == global_path_t::OK || m.status == global_path_t::NO_PATH) && m.points.size() >= 2;
+  std::optional<Vec3> vehicle;
+  if (nav_) vehicle = to_vec3(nav_->position);
+  log_lines(supervisor_.route(route, vehicle));
 }
 
 void RhOptimizerService::on_control_status(const control_status_t& m) {
-  legs_.follow(m.mission_id, m.active_waypoint);
+  supervisor_.controller_leg(m.mission_id, m.active_waypoint);
   // Only while a reference is flown: holding before the mission or done
   // after it, the error says nothing of gusts.
   if (m.mode == control_status_t::WAYPOINT || m.mode == control_status_t::TRAJECTORY ||
       m.mode == control_status_t::SAFE_STOP)
-    tube_.add(to_seconds(m.utime),
-              Vec3(m.position_error[0], m.position_error[1], m.position_error[2]));
-}
-
-double RhOptimizerService::tracking_widening(Utime now) {
-  const double widening = tube_.extra_clearance();
-  if (std::abs(widening - logged_widening_) >= 0.25 ||
-      (widening == 0.0) != (logged_widening_ == 0.0)) {
-    node_.log().info(
-        "t={:.2f} s tracking tube: clearances widened by {:.2f} m (largest position error {:.2f} m "
-        "over the last {:.0f} s)",
-        to_seconds(now), widening, tube_.largest_error(), config_.tracking_tube.window);
-    logged_widening_ = widening;
-  }
-  return widening;
+    supervisor_.tracking_error(to_seconds(m.utime),
+                               Vec3(m.position_error[0], m.position_error[1], m.position_error[2]));
 }
 
 void RhOptimizerService::on_scan(const scan_world_t& m) {
-  scan_supply_.received(to_seconds(node_.now()), m.scan_index);
+  supervisor_.scan_received(to_seconds(node_.now()), m.scan_index);
   const Vec3 origin = to_vec3(m.sensor_origin);
   const double altitude = -origin.z();
   for (const auto& p : m.points)
@@ -411,14 +390,19 @@ void RhOptimizerService::on_scan(const scan_world_t& m) {
   }
 }
 
-bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
-  if (!grid_) return false;
+MapView RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
+  MapView map;
+  map.heightfield = &heightfield_;
+  map.clearance = [this](const Vec3& p) { return field_.query(p); };
+  if (config_.occlusion_depth > 0)
+    map.seen = [this](double north, double east) { return visibility_.seen(north, east); };
+  if (!grid_) return map;
   const double vehicle_altitude = -vehicle.z();
   const bool band_moved =
       std::abs(vehicle_altitude - field_altitude_) > 0.25 * config_.field_altitude_band;
   const bool due = field_built_ == INT64_MIN ||
                    now - field_built_ >= to_utime(config_.field_period) || band_moved;
-  if (field_valid_ && !(grid_dirty_ && due) && !band_moved) return true;
+  if (field_valid_ && !(grid_dirty_ && due) && !band_moved) return map;
   heightfield_ = padded_heightfield(*grid_, config_.field.max_distance + config_.occlusion_depth);
   const double ground = config_.optimizer.ground_altitude;
   const double alt = vehicle_altitude - ground;
@@ -446,15 +430,7 @@ bool RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
   field_built_ = now;
   field_altitude_ = vehicle_altitude;
   grid_dirty_ = false;
-  return true;
-}
-
-void RhOptimizerService::hand_back(Utime now, const Vec3& position, const Vec3& velocity,
-                                   const std::string& why) {
-  publish_nominal(now, position, velocity);
-  restart_planning();
-  node_.log().info("avoidance hands back to waypoint guidance at t={:.2f} s ({})", to_seconds(now),
-                   why);
+  return map;
 }
 
 void RhOptimizerService::publish_nominal(Utime now, const Vec3& position, const Vec3& velocity) {
@@ -479,16 +455,6 @@ void RhOptimizerService::publish_nominal(Utime now, const Vec3& position, const 
   node_.publish(channels::kRefTraj, m);
 }
 
-void RhOptimizerService::restart_planning() {
-  planner_.reset();
-  recovery_.reset();
-  last_step_moving_ = false;
-  last_trajectory_ = BsplineTrajectory();
-  last_trajectory_kind_ = LastPlan::kMoving;
-  stopping_at_target_ = false;
-  stalled_ = false;
-}
-
 narrow_passages_t passages_message(const std::vector<NarrowPassage>& passages, int32_t mission_id,
                                    Utime utime) {
   narrow_passages_t m;
@@ -507,105 +473,33 @@ narrow_passages_t passages_message(const std::vector<NarrowPassage>& passages, i
 void RhOptimizerService::publish_passages(Utime now) {
   if (!mission_ || !config_.passages.enabled) return;
   node_.publish(channels::kNarrowPassages,
-                passages_message(passages_.passages(), mission_->mission_id, now));
+                passages_message(supervisor_.passages(), mission_->mission_id, now));
 }
 
-double RhOptimizerService::pinch_clearance(const Limits& limits) const {
-  // What the optimiser accepts as feasible: its clearance, less its
-  // (normalised) feasibility tolerance. Dense seed 83 blocked a gap 1 cm
-  // short of the clearance, which it had flown before, and lost its way.
-  return (limits.clearance + config_.optimizer.clearance_margin) *
-         (1.0 - config_.optimizer.feasibility_tolerance);
-}
-
-bool RhOptimizerService::check_route_for_pinch(Utime now, const Limits& limits,
-                                               const GuidanceFrame& leg) {
-  if (!field_valid_) return false;
-  // On the field the plans are made on, after the look: the shadows
-  // behind what was seen (occlusion) it cleared are gone, those left are
-  // what the optimiser will meet. (Checked when the vehicle got stuck,
-  // before the look, a gap they closed then was open after it: dense seed
-  // 68 lost its way so.)
-  const ClearanceQuery clearance = [this](const Vec3& p) { return field_.query(p); };
-  const double required = pinch_clearance(limits);
-  std::optional<NarrowPassage> pinch =
-      find_narrow_passage(clearance, recovery_route_, required, config_.passages);
-  const char* what = "the route passes a pinch";
-  if (!pinch && !recovery_route_.empty()) {
-    // An escape flies to the route's first corner and stops there; the
-    // route's sections may leave room to pass a corner in a gap but none
-    // to stop in it, and the escape stalled there look after look (dense
-    // seed 162).
-    const auto corner = escape_leg_end(recovery_route_, leg, config_.recovery.capture_radius);
-    if (corner && *corner > 0) {
-      pinch = find_cramped_stop(clearance, recovery_route_[*corner], required, config_.passages);
-      what = "the escape would stop at a corner with no room";
-    }
+void RhOptimizerService::log_lines(const std::vector<LogLine>& lines) {
+  for (const LogLine& line : lines) {
+    if (line.level == LogLine::Level::kWarn)
+      node_.log().warn("{}", line.text);
+    else
+      node_.log().info("{}", line.text);
   }
-  // One the planner knows already is not its doing (a zone round the
-  // start, which routes may leave): the route is taken.
-  if (!pinch || !passages_.add(*pinch)) return false;
-  const double ground = config_.optimizer.ground_altitude;
-  node_.log().warn(
-      "t={:.2f} s {} with {:.2f} m of the {:.2f} m clearance: told to the global planner (no "
-      "route within {:.1f} m of ({:.1f}, {:.1f}) m north/east, {:.1f} to {:.1f} m above the "
-      "ground)",
-      to_seconds(now), what, pinch->clearance, required, pinch->radius, pinch->centre.x(),
-      pinch->centre.y(), -(pinch->centre.z() + pinch->half_height) - ground,
-      -(pinch->centre.z() - pinch->half_height) - ground);
-  publish_passages(now);
-  return true;
 }
 
-RecoveryDecision RhOptimizerService::update_recovery(Utime now, const Leg& leg,
-                                                     const Limits& limits, const Vec3& position,
-                                                     const Vec3& velocity, bool engaged) {
-  RecoveryInput in;
-  in.time = to_seconds(now);
-  in.position = position;
-  in.velocity = velocity;
-  in.altitude = -position.z() - config_.optimizer.ground_altitude;
-  in.max_vertical_speed = limits.max_vertical_speed;
-  in.yaw = nav_->euler[2];
-  in.engaged = engaged;
-  in.moving_plan = last_step_moving_;
-  in.route = route_kind_;
-  in.route_time = route_kind_utime_ == INT64_MIN ? -1e300 : to_seconds(route_kind_utime_);
-  in.route_points = &recovery_route_;
-  in.leg = GuidanceFrame::from_leg(leg.from, leg.to);
-  in.route_flyable = [&] { return !check_route_for_pinch(now, limits, in.leg); };
-  RecoveryDecision decision = recovery_.update(in);
-  if (decision.changed) {
-    node_.log().warn("t={:.2f} s recovery: {}: {}", in.time, to_string(decision.phase),
-                     decision.reason);
-    // Each phase plans afresh: an escape in its own frame, normal planning
-    // from wherever the escape or the look left the vehicle.
-    planner_.reset();
-    route_changed_ = true;
-    last_step_moving_ = false;
-  }
-  return decision;
-}
-
-void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::string& message,
-                                       const SolveReport* report, bool guidance_clear) {
-  if (!step_warned_)
-    for (const std::string& line : warning_streak_.clear(to_seconds(now)))
-      node_.log().warn("{}", line);
-  step_warned_ = false;
+void RhOptimizerService::publish_stats(Utime now, const SupervisorDecision& d) {
   solver_stats_t s{};
-  s.guidance_clear = guidance_clear && field_valid_;
+  s.guidance_clear = d.guidance_clear && field_valid_;
   s.mission_id = mission_ ? mission_->mission_id : -1;
-  s.active_waypoint = active_leg_;
+  s.active_waypoint = supervisor_.active_leg();
   s.utime = now;
-  s.status = status;
-  s.message = recovery_message(recovery_.phase(), message);
-  if (report) {
-    s.iterations = report->iterations;
-    s.solve_time = report->solve_time;
-    s.max_constraint_violation = std::isfinite(report->max_violation) ? report->max_violation : 1e9;
-    s.cost = std::isfinite(report->cost) ? report->cost : 0.0;
-    s.warm_started = report->warm_started;
+  s.status = stats_code(d.status);
+  s.message = d.message;
+  if (d.report) {
+    const SolveReport& report = *d.report;
+    s.iterations = report.iterations;
+    s.solve_time = report.solve_time;
+    s.max_constraint_violation = std::isfinite(report.max_violation) ? report.max_violation : 1e9;
+    s.cost = std::isfinite(report.cost) ? report.cost : 0.0;
+    s.warm_started = report.warm_started;
   }
   s.map_utime = field_valid_ ? field_map_utime_ : 0;
   node_.publish(channels::kSolverStats, s);
@@ -613,204 +507,50 @@ void RhOptimizerService::publish_stats(Utime now, int8_t status, const std::stri
 
 void RhOptimizerService::tick() {
   const Utime now = node_.now();
-  auto note = [&](const std::string& text) {
-    if (text != last_note_) node_.set_state(text);
-    last_note_ = text;
-  };
-  if (!mission_ || !nav_) return note("waiting for mission and nav");
-  if (now - nav_->utime > to_utime(config_.nav_max_age)) {
-    note("nav stale");
-    return publish_stats(now, solver_stats_t::NOT_RUN, "nav stale", nullptr);
+  TickInput in;
+  in.now = now;
+  if (nav_) {
+    NavInput nav;
+    nav.utime = nav_->utime;
+    nav.position = to_vec3(nav_->position);
+    nav.velocity = to_vec3(nav_->velocity);
+    nav.acceleration = to_vec3(nav_->acceleration);
+    nav.yaw = nav_->euler[2];
+    in.nav = nav;
   }
-  const Vec3 position = to_vec3(nav_->position);
-  const Vec3 velocity = to_vec3(nav_->velocity);
-  if (!legs_.has_plan()) legs_.set_plan(mission_->mission_id, waypoints_from(*mission_), position);
-  const auto active = legs_.update(position);
-  if (!active) return note("no leg");
-  if (active->index != active_leg_) {
-    // A new leg is a new guidance frame: the previous solution is no guess.
-    active_leg_ = active->index;
-    planner_.reset();
-    recovery_.reset();
-    route_changed_ = true;
-  }
-  if (!grid_ || now - grid_->utime > to_utime(config_.grid_max_age)) {
-    // Blind: no decisions on a map that is not there. An engaged avoidance
-    // keeps its last trajectory until the controller times it out.
-    note("no fresh obstacle grid");
-    return publish_stats(now, solver_stats_t::NOT_RUN, "no fresh obstacle grid", nullptr);
-  }
-  // A map fed by a trickle of scans is as blind as none: no plans, and
-  // guidance holds (PerceptionWatch); the controller flies the last plan's
-  // stop.
-  if (scan_supply_.starved(to_seconds(now))) {
-    if (!scans_starved_)
-      node_.log().warn("map starved of scans at t={:.2f} s ({}): no plans until fed again",
-                       to_seconds(now), scan_supply_.why());
-    scans_starved_ = true;
-    note("map starved of scans");
-    return publish_stats(now, solver_stats_t::NOT_RUN,
-                         "map starved of scans: " + scan_supply_.why(), nullptr);
-  }
-  if (scans_starved_) {
-    node_.log().info("map fed again at t={:.2f} s ({:.0f} % of the scans arrive)", to_seconds(now),
-                     100.0 * scan_supply_.share());
-    scans_starved_ = false;
-  }
-  refresh_field(now, position);
+  if (grid_) in.grid_utime = grid_->utime;
+  in.map = [this, now, &in] { return refresh_field(now, in.nav->position); };
+  const SupervisorDecision d = supervisor_.tick(in);
 
-  Limits limits = limits_from(mission_->limits);
-  limits.clearance += tracking_widening(now);
-  const Leg leg{active->from, active->to};
-  const ClearanceQuery clearance = [this](const Vec3& p) { return field_.query(p); };
-  const double required = limits.clearance + config_.avoidance.engage_margin;
-  const NominalCheck nominal = check_nominal_path(clearance, leg, position, limits.sensor_range,
-                                                  required, config_.avoidance);
-  const bool conflict = std::isfinite(nominal.conflict_distance);
-  const bool was_engaged = switch_.engaged();
+  if (d.state != last_note_) node_.set_state(d.state);
+  last_note_ = d.state;
+  // In the order the decisions were taken: the narrow passage found on the
+  // way, the trajectory, the step's report.
+  if (d.passages_changed) publish_passages(now);
+  using Publish = SupervisorDecision::Publish;
+  switch (d.publish) {
+    case Publish::kNothing:
+    case Publish::kStats:
+      break;
+    case Publish::kNominal:
+      publish_nominal(now, in.nav->position, in.nav->velocity);
+      break;
+    case Publish::kHover:
+    case Publish::kStep:
+      node_.publish(channels::kRefTraj, trajectory_message(d.trajectory, d.t0, traj_mode(d.mode),
+                                                           config_.sample_period, now));
+      break;
+  }
+  log_lines(d.log);
+  if (d.publish == Publish::kNothing) return;
+  // One line per streak of like failed steps (the first in full, then a
+  // summary); every step's message still goes out in SOLVER_STATS.
   const double t = to_seconds(now);
-  const double stopping_speed = stopping_at_target_ ? velocity.norm() : 0.0;
-  // Only while the plan stops there, so that the switch asks for rest
-  // (stopping_speed): handed back at speed so near, guidance overshoots.
-  const bool at_last_waypoint = stopping_at_target_ && active->final &&
-                                (position - active->to).norm() <= active->capture_radius;
-  const bool engaged = switch_.update(t, conflict, cross_track_distance(leg, position),
-                                      stopping_speed, at_last_waypoint);
-  const RecoveryDecision recovery = update_recovery(now, leg, limits, position, velocity, engaged);
-  if (!engaged) {
-    if (was_engaged) {
-      hand_back(now, position, velocity, "nominal path clear, back on the leg");
-    } else if (++ticks_since_nominal_ >= static_cast<int64_t>(std::ceil(config_.rate))) {
-      // Once a second while guidance is clear: a controller left flying the
-      // stop of a plan from an optimiser that has since died and restarted
-      // learns that guidance may resume.
-      publish_nominal(now, position, velocity);
-      ticks_since_nominal_ = 0;
-    }
-    note("nominal guidance");
-    return publish_stats(now, solver_stats_t::NOT_RUN, "nominal guidance: path clear", nullptr,
-                         true);
-  }
-  if (!was_engaged)
-    node_.log().info(
-        "avoidance engages at t={:.2f} s: nominal path clearance {:.1f} m < {:.1f} m, {:.1f} m "
-        "ahead",
-        t, nominal.least_clearance, required, nominal.conflict_distance);
-
-  StepInput in;
-  // On the last plan while the vehicle is near it, else at the measured
-  // state (start_state.hpp).
-  StartStateSettings start_rules;
-  start_rules.planned_initial_state = config_.planned_initial_state;
-  start_rules.replan_position_error = config_.replan_position_error;
-  start_rules.replan_velocity_error = config_.replan_velocity_error;
-  start_rules.planned_initial_acceleration = config_.planned_initial_acceleration;
-  start_rules.stop_recapture_error = config_.stop_recapture_error;
-  const StartState start = choose_start_state(
-      last_trajectory_, last_trajectory_kind_, to_seconds(now - last_trajectory_t0_),
-      MeasuredState{position, velocity, to_vec3(nav_->acceleration)}, mission_->limits.max_accel,
-      start_rules);
-  FramingSettings framing;
-  framing.clearance_margin = config_.optimizer.clearance_margin;
-  framing.pinch_clearance = pinch_clearance(limits);
-  framing.max_shift = config_.passages.max_shift;
-  in.problem =
-      leg_problem(leg, active->final, start, position, limits, clearance, heightfield_, framing);
-  RhProblem& p = in.problem;
-  stopping_at_target_ = p.stop_at_target;
-  in.time = t;
-  if (!route_.empty() && now - route_utime_ <= to_utime(config_.path_max_age))
-    in.global_path = route_;
-  in.global_path_changed = route_changed_;
-  route_changed_ = false;
-
-  if (recovery.phase == RecoveryPhase::kLooking || recovery.phase == RecoveryPhase::kTurning ||
-      recovery.phase == RecoveryPhase::kNoRoute) {
-    // Hover where the stop from the state flown ends; while looking (or
-    // turning to an escape leg), the controller turns the heading.
-    const bool looking = recovery.phase != RecoveryPhase::kNoRoute;
-    const BsplineTrajectory hover = planner_.braking_trajectory(p);
-    const Utime t0 = to_utime(t);
-    const int8_t mode = !looking             ? ref_traj_t::BRAKING
-                        : recovery.turn_left ? ref_traj_t::LOOK_AROUND_LEFT
-                                             : ref_traj_t::LOOK_AROUND;
-    node_.publish(channels::kRefTraj,
-                  trajectory_message(hover, t0, mode, config_.sample_period, now));
-    last_trajectory_ = hover;
-    last_trajectory_kind_ = LastPlan::kStop;
-    last_trajectory_t0_ = t0;
-    last_step_moving_ = false;
-    note(std::string("recovery: ") + to_string(recovery.phase));
-    return publish_stats(now, looking ? solver_stats_t::LOOKING_AROUND : solver_stats_t::NO_ROUTE,
-                         std::string("recovery: ") + to_string(recovery.phase), nullptr);
-  }
-  const bool escaping = recovery.phase == RecoveryPhase::kEscaping;
-  if (escaping) {
-    // The leg of the escape: from where it began to where the route turns
-    // forward again, along the route; the forward-speed rule of Eq. 8 is
-    // relaxed (the route may bend back), the commit gate is not.
-    frame_escape(&p, recovery.escape_from, recovery.escape_point, position, heightfield_, framing);
-    stopping_at_target_ = false;
-    in.global_path = recovery.escape_route;
-  }
-  if (config_.occlusion_depth > 0)
-    in.seen = [this](double north, double east) { return visibility_.seen(north, east); };
-
-  // A climb to look over what the scanner saw from below, straight up from
-  // the hover the look left; the controller turns the heading on the way,
-  // so the scanner looks all round at every altitude it passes.
-  const bool climbing = recovery.phase == RecoveryPhase::kClimbing;
-  const StepOutput out =
-      climbing ? planner_.climb(in, -(config_.optimizer.ground_altitude + recovery.climb_altitude))
-               : planner_.step(in);
-  ++steps_;
-  // A plan that moves off, not a stop, a stall or a hover in place: the
-  // recovery counts the vehicle stuck without one.
-  last_step_moving_ = plan_moves_off(out, 2.0 * config_.recovery.capture_radius);
-  // Deferring leaves the vehicle to nominal guidance: only before this
-  // engagement has published anything. Once a plan or a stop has been
-  // flown, the controller holds to it (and to its stop) and a silence
-  // would only leave it hovering.
-  if (out.mode == StepMode::kBraking && last_trajectory_.empty() &&
-      defer_first_brake(nominal.conflict_distance, velocity,
-                        config_.fallback.braking_accel_fraction * limits.max_accel,
-                        config_.defer_margin)) {
-    note("avoidance deferred: no trajectory yet");
-    return publish_stats(now, solver_stats_t::DEFERRED,
-                         "no avoidance trajectory yet (" + out.reason +
-                             "); conflict still far, nominal guidance continues",
-                         &out.report, true);
-  }
-  const Utime t0 = to_utime(out.start_time);
-  const int8_t mode =
-      climbing && out.mode == StepMode::kSolved ? ref_traj_t::LOOK_AROUND : traj_mode(out.mode);
-  node_.publish(channels::kRefTraj,
-                trajectory_message(out.trajectory, t0, mode, config_.sample_period, now));
-  last_trajectory_ = out.trajectory;
-  last_trajectory_kind_ = out.mode == StepMode::kBraking ? LastPlan::kStop : LastPlan::kMoving;
-  last_trajectory_t0_ = t0;
-  std::string message = recovery_message(recovery.phase, to_string(out.mode));
-  if (!out.reason.empty()) message += ": " + out.reason;
-  if (out.mode == StepMode::kSolved && out.refused > 0)
-    message += (out.reason.empty() ? ": " : "; ") + std::string("the commit gate refused ") +
-               std::to_string(out.refused) + " other plan(s) (" + out.refusal + ")";
-  if (out.mode != StepMode::kSolved) {
-    // One line per streak of like steps (the first in full, then a
-    // summary); every step's message still goes out in SOLVER_STATS.
-    step_warned_ = true;
-    const std::string text = fmt::format("t={:.2f} s {} ({} solves, worst violation {:.3g})", t,
-                                         message, out.solves, out.report.max_violation);
-    for (const std::string& line :
-         warning_streak_.warn(t, recovery_message(recovery.phase, to_string(out.mode)), text,
-                              out.report.max_violation))
-      node_.log().warn("{}", line);
-  } else if (out.refused > 0)
-    node_.log().info("t={:.2f} s {}", t, message);
-  else if (out.stalled != stalled_)
-    node_.log().info("t={:.2f} s {}", t, out.stalled ? message : "no longer stalled");
-  stalled_ = out.stalled;
-  note(std::string("avoiding: ") + to_string(out.mode));
-  publish_stats(now, stats_status(out.mode), message, &out.report);
+  const std::vector<std::string> streak =
+      d.warning ? warning_streak_.warn(t, d.warning->kind, d.warning->text, d.warning->figure)
+                : warning_streak_.clear(t);
+  for (const std::string& line : streak) node_.log().warn("{}", line);
+  publish_stats(now, d);
 }
 
 }  // namespace ofn::rh

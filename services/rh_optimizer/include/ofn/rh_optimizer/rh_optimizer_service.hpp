@@ -1,19 +1,18 @@
 #pragma once
 // Binds the RH optimiser to the bus (paper 2.2): NAV_STATE, MISSION,
-// OBSTACLE_GRID and GLOBAL_PATH in; REF_TRAJ and SOLVER_STATS out at a fixed
-// rate, and NARROW_PASSAGES (passages of the global route it found it
-// cannot fly) for the global planner. It builds the distance field from the grid, decides when
-// avoidance overrides nominal waypoint guidance (AvoidanceSwitch), and while it does, solves one
-// receding-horizon step per tick and publishes the trajectory the controller follows. Handing back,
-// it publishes a NOMINAL trajectory so the controller resumes waypoint guidance at once.
+// OBSTACLE_GRID, GLOBAL_PATH, SCAN_WORLD and CONTROL_STATUS in; REF_TRAJ and
+// SOLVER_STATS out at a fixed rate, and NARROW_PASSAGES (passages of the
+// global route it found it cannot fly) for the global planner. It builds the
+// distance field from the grid and the record of seen space from the scans;
+// every decision (engage, hand back, recovery, defer, what is published and
+// as what mode) is the AvoidanceSupervisor's, whose decision this class
+// turns into messages and log lines.
 
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "ofn/common/config.hpp"
-#include "ofn/common/leg_tracker.hpp"
-#include "ofn/common/mission_plan.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/warning_streak.hpp"
 #include "ofn/control_status_t.hpp"
@@ -25,14 +24,8 @@
 #include "ofn/nav_state_t.hpp"
 #include "ofn/obstacle_grid_t.hpp"
 #include "ofn/ref_traj_t.hpp"
-#include "ofn/rh_optimizer/avoidance_switch.hpp"
-#include "ofn/rh_optimizer/dead_end_recovery.hpp"
-#include "ofn/rh_optimizer/narrow_passage.hpp"
+#include "ofn/rh_optimizer/avoidance_supervisor.hpp"
 #include "ofn/rh_optimizer/occlusion.hpp"
-#include "ofn/rh_optimizer/rh_planner.hpp"
-#include "ofn/rh_optimizer/scan_supply.hpp"
-#include "ofn/rh_optimizer/start_state.hpp"
-#include "ofn/rh_optimizer/tracking_tube.hpp"
 #include "ofn/scan_world_t.hpp"
 #include "ofn/solver_stats_t.hpp"
 
@@ -114,18 +107,12 @@ ref_traj_t trajectory_message(const BsplineTrajectory& trajectory, Utime t0, int
 narrow_passages_t passages_message(const std::vector<NarrowPassage>& passages, int32_t mission_id,
                                    Utime utime);
 
-/// Largest distance from a point of `b` (over its first `horizon` metres
-/// from `from`) to the polyline `a`: how much two routes differ where it
-/// matters.
-double route_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const Vec3& from,
-                        double horizon);
-
 class RhOptimizerService {
  public:
   RhOptimizerService(lcm::LCM& lcm, const Clock& clock, RhOptimizerServiceConfig config);
   Node& node() { return node_; }
-  bool engaged() const { return switch_.engaged(); }
-  int64_t steps() const { return steps_; }
+  bool engaged() const { return supervisor_.engaged(); }
+  int64_t steps() const { return supervisor_.steps(); }
 
  private:
   void on_nav(const nav_state_t& m) { nav_ = m; }
@@ -136,40 +123,21 @@ class RhOptimizerService {
   /// The controller's active leg (LegTracker::follow) and its position
   /// error (the tracking tube).
   void on_control_status(const control_status_t& m);
-  /// m the safety radius is widened by now (TrackingTube), logged when it
-  /// changes by a quarter metre or more.
-  double tracking_widening(Utime now);
+  /// One decision of the supervisor, published and logged.
   void tick();
-  bool refresh_field(Utime now, const Vec3& vehicle);
-  void hand_back(Utime now, const Vec3& position, const Vec3& velocity, const std::string& why);
+  /// Brings the distance field up to date for a tick that plans.
+  MapView refresh_field(Utime now, const Vec3& vehicle);
   void publish_nominal(Utime now, const Vec3& position, const Vec3& velocity);
   /// The mission's passages, for the global planner (on change and 1 Hz).
   void publish_passages(Utime now);
-  /// The clearance a route's pinches and stops are checked for: what the
-  /// optimiser accepts as feasible.
-  double pinch_clearance(const Limits& limits) const;
-  /// The route the recovery is about to take after a look: a new pinch on
-  /// it, or no room to stop at the corner its escape would stop at, is
-  /// remembered and published, so that the planner's next route goes
-  /// another way. True if one was. `leg`: the mission leg's frame.
-  bool check_route_for_pinch(Utime now, const Limits& limits, const GuidanceFrame& leg);
-  /// Feeds the dead-end recovery; logs and acts on a change of its phase.
-  RecoveryDecision update_recovery(Utime now, const Leg& leg, const Limits& limits,
-                                   const Vec3& position, const Vec3& velocity, bool engaged);
-  /// Forgets the planner's previous plan, the last published one and the
-  /// engagement's stop and stall flags (a new mission, a hand-back).
-  void restart_planning();
+  void log_lines(const std::vector<LogLine>& lines);
   /// `guidance_clear`: the nominal leg was checked on the current field and
   /// waypoint guidance may fly it (the controller's PerceptionWatch).
-  void publish_stats(Utime now, int8_t status, const std::string& message,
-                     const SolveReport* report, bool guidance_clear = false);
+  void publish_stats(Utime now, const SupervisorDecision& decision);
 
   Node node_;
   RhOptimizerServiceConfig config_;
-  RhPlanner planner_;
-  AvoidanceSwitch switch_;
-  LegTracker legs_;
-  int active_leg_ = -1;
+  AvoidanceSupervisor supervisor_;
   std::optional<nav_state_t> nav_;
   std::optional<mission_t> mission_;
   std::optional<obstacle_grid_t> grid_;
@@ -177,10 +145,6 @@ class RhOptimizerService {
   VisibilityRecord visibility_;
   ShadowMemory shadows_;
   int64_t scans_seen_ = 0;
-  ScanSupply scan_supply_;
-  bool scans_starved_ = false;
-  TrackingTube tube_;
-  double logged_widening_ = 0;  // m, the tube's widening last logged
   mapping::Heightfield heightfield_;
   // heightfield_ before the shadows: what the unseen extension starts from
   mapping::Heightfield mapped_;
@@ -190,28 +154,8 @@ class RhOptimizerService {
   // The stamp of the grid the field was built from (SOLVER_STATS.map_utime).
   Utime field_map_utime_ = 0;
   double field_altitude_ = 0;  // vehicle altitude the field's band is centred on
-  std::vector<Vec3> route_;    // global path in use as the cold-start guess
-  // What the global planner said last, and the points of its route (any
-  // kind): the dead-end recovery escapes along them.
-  RouteKind route_kind_ = RouteKind::kNone;
-  Utime route_kind_utime_ = INT64_MIN;
-  std::vector<Vec3> recovery_route_;
-  DeadEndRecovery recovery_;
-  PassageMemory passages_;
-  bool last_step_moving_ = false;  // the last step committed a plan that moves off
-  LastPlan last_trajectory_kind_ = LastPlan::kMoving;  // what last_trajectory_ is
-  Utime route_utime_ = INT64_MIN;
-  bool route_changed_ = false;
-  BsplineTrajectory last_trajectory_;  // last published, for a(t0)
-  Utime last_trajectory_t0_ = 0;
-  bool stopping_at_target_ = false;  // the last plan stops at the last waypoint
-  // Failed steps are logged once per streak (common/warning_streak.hpp);
-  // step_warned_: this step's failure was handed to it.
+  // Failed steps are logged once per streak (common/warning_streak.hpp).
   WarningStreak warning_streak_{"worst violation"};
-  bool step_warned_ = false;
-  bool stalled_ = false;  // the last step's warm plan was a stall (logged once)
-  int64_t steps_ = 0;
-  int64_t ticks_since_nominal_ = 0;
   std::string last_note_;
 };
 
