@@ -13,8 +13,8 @@
 #include <optional>
 #include <string>
 
-#include "ofn/common/clock.hpp"
 #include "ofn/common/frames.hpp"
+#include "ofn/common/time.hpp"
 
 namespace ofn::report {
 
