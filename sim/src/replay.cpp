@@ -256,10 +256,14 @@ MessageDifference message_difference(const std::string& channel, const Bytes& re
   return {kStructural, 0.0};
 }
 
-// solve_time is the wall time a solve took: it never repeats, so it is
-// left out of the byte comparison.
+// The payload alone: the sequence trailer names the publisher, which is
+// another one in the replay. solve_time is the wall time a solve took: it
+// never repeats, so it is left out of the byte comparison.
 Bytes comparable(const std::string& channel, const Bytes& bytes) {
-  if (channel != channels::kSolverStats) return bytes;
+  if (channel != channels::kSolverStats) {
+    const size_t payload = bus_auth::payload_bytes(bytes.data(), bytes.size());
+    return Bytes(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(payload));
+  }
   solver_stats_t stats;
   if (!decode(bytes, stats)) return bytes;
   stats.solve_time = 0.0;
@@ -323,14 +327,14 @@ class Session {
     if (first_time_ == INT64_MIN) first_time_ = event.timestamp;
     last_time_ = event.timestamp;
     // A log of an authenticated flight: the replay runs on an open bus and
-    // compares payloads, so the authentication trailer is left off.
+    // compares payloads, so the authentication trailer is left off (the
+    // sequence trailer stays: the replayed services count by it).
     auto size = static_cast<unsigned>(event.datalen);
     if (bus_auth::ends_with_trailer(event.data, size)) size -= bus_auth::kTrailerBytes;
     if (follow_sim_clock_) {
       if (event.channel == channels::kSimClock) {
         sim_clock_t tick;
-        if (tick.decode(event.data, 0, static_cast<int>(size)) == static_cast<int>(size))
-          step_to(tick.utime);
+        if (bus_auth::decode_payload(tick, event.data, size)) step_to(tick.utime);
       }
     } else {
       step_to(event.timestamp);

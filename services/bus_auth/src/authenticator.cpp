@@ -65,26 +65,14 @@ void write_text(const std::string& path, const std::string& text, mode_t mode) {
     throw KeyError("cannot write '" + path + "': " + std::strerror(errno));
 }
 
-void put_be64(uint8_t* out, uint64_t value) {
-  for (int i = 7; i >= 0; --i) {
-    out[i] = static_cast<uint8_t>(value & 0xff);
-    value >>= 8;
-  }
-}
-
-uint64_t get_be64(const uint8_t* in) {
-  uint64_t value = 0;
-  for (int i = 0; i < 8; ++i) value = (value << 8) | in[i];
-  return value;
-}
-
 bool matches(const std::string& pattern, const std::string& channel) {
   if (!pattern.empty() && pattern.back() == '*')
     return channel.compare(0, pattern.size() - 1, pattern, 0, pattern.size() - 1) == 0;
   return pattern == channel;
 }
 
-// The bytes a signature covers: tag, channel, NUL, payload, role, sequence.
+// The bytes a signature covers: tag, channel, NUL, payload (with its
+// sequence trailer), role, sequence.
 void signed_bytes(const std::string& channel, const uint8_t* payload, size_t payload_size,
                   const uint8_t* role_and_sequence, std::vector<uint8_t>& out) {
   out.clear();

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -348,6 +349,76 @@ TEST(TrailerDecode, PayloadAloneOrWithTrailerOnly) {
   no_magic.pop_back();
   no_magic.push_back('X');
   EXPECT_FALSE(decode_payload(fixed, no_magic.data(), no_magic.size()));
+}
+
+TEST(TrailerDecode, TheSequenceTrailerAloneOrBeforeTheSignature) {
+  struct FixedMessage {
+    int length;
+    int decode(const void*, int, int maxlen) { return maxlen < length ? -1 : length; }
+  };
+  FixedMessage fixed{24};
+  auto numbered = payload(24);
+  append_sequence_trailer(numbered, {0x0102030405060708ULL, 42});
+  ASSERT_EQ(numbered.size(), 24 + kSequenceTrailerBytes);
+  ASSERT_TRUE(ends_with_sequence_trailer(numbered.data(), numbered.size()));
+  Trailers trailers;
+  ASSERT_TRUE(decode_payload(fixed, numbered.data(), numbered.size(), &trailers));
+  EXPECT_TRUE(trailers.sequenced);
+  EXPECT_FALSE(trailers.signed_);
+  EXPECT_EQ(trailers.sequence.publisher, 0x0102030405060708ULL);
+  EXPECT_EQ(trailers.sequence.sequence, 42u);
+  // Big endian, as the authentication trailer's fields.
+  EXPECT_EQ(numbered[24], 0x01);
+  EXPECT_EQ(numbered[24 + 15], 42);
+
+  // Signed after it: the signature covers the sequence trailer.
+  Deployment deployment;
+  auto signer = deployment.as("onboard2");
+  auto sealed = numbered;
+  signer.seal("REF_TRAJ", sealed);
+  ASSERT_EQ(sealed.size(), 24 + kMaxTrailerBytes);
+  trailers = {};
+  ASSERT_TRUE(decode_payload(fixed, sealed.data(), sealed.size(), &trailers));
+  EXPECT_TRUE(trailers.sequenced);
+  EXPECT_TRUE(trailers.signed_);
+  EXPECT_EQ(trailers.sequence.sequence, 42u);
+  auto controller = deployment.as("onboard1");
+  const Opened opened = controller.open("REF_TRAJ", sealed.data(), sealed.size());
+  ASSERT_TRUE(opened.authentic) << opened.reason;
+  EXPECT_EQ(opened.payload_size, numbered.size());
+  // A signed message without a sequence trailer (an older recording).
+  auto signed_only = payload(24);
+  deployment.now += 10;
+  signer.seal("REF_TRAJ", signed_only);
+  trailers = {};
+  ASSERT_TRUE(decode_payload(fixed, signed_only.data(), signed_only.size(), &trailers));
+  EXPECT_FALSE(trailers.sequenced);
+  EXPECT_TRUE(trailers.signed_);
+  // Not after the signature, and not a sequence trailer cut short.
+  auto wrong_order = signed_only;
+  append_sequence_trailer(wrong_order, {1, 1});
+  EXPECT_FALSE(decode_payload(fixed, wrong_order.data(), wrong_order.size()));
+  EXPECT_FALSE(decode_payload(fixed, numbered.data(), numbered.size() - 1));
+
+  // The payload alone, by the magic: what a comparison of payloads reads.
+  EXPECT_EQ(payload_bytes(sealed.data(), sealed.size()), 24u);
+  EXPECT_EQ(payload_bytes(numbered.data(), numbered.size()), 24u);
+  EXPECT_EQ(payload_bytes(signed_only.data(), signed_only.size()), 24u);
+}
+
+TEST(TrailerDecode, APayloadThatEndsLikeATrailerIsNotCut) {
+  // A message whose own last bytes spell the magic, with nothing after it:
+  // the decoder says where it ends, so no trailer is read.
+  struct FixedMessage {
+    int length;
+    int decode(const void*, int, int maxlen) { return maxlen < length ? -1 : length; }
+  };
+  std::vector<uint8_t> bytes = payload(40);
+  std::memcpy(bytes.data() + 36, kSequenceTrailerMagic.data(), 4);
+  FixedMessage whole{40};
+  Trailers trailers;
+  ASSERT_TRUE(decode_payload(whole, bytes.data(), bytes.size(), &trailers));
+  EXPECT_FALSE(trailers.sequenced);
 }
 
 }  // namespace

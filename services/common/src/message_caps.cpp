@@ -54,7 +54,9 @@ const std::map<std::string, size_t>& caps() {
 }
 // clang-format on
 
-// HEARTBEAT_<NAME>: largest 149 B, fixed fields and three short strings.
+// HEARTBEAT_<NAME>: largest 884 B, the flight monitor's (fixed fields, three
+// short strings and twelve inputs of 45 B and a channel name each; 149 B
+// without the inputs).
 constexpr size_t kHeartbeatCap = 4 * kKiB;
 
 }  // namespace
@@ -71,7 +73,7 @@ size_t max_message_bytes(const std::string& channel) {
 }
 
 size_t max_received_bytes(const std::string& channel) {
-  return max_message_bytes(channel) + bus_auth::kTrailerBytes;
+  return max_message_bytes(channel) + bus_auth::kMaxTrailerBytes;
 }
 
 }  // namespace ofn

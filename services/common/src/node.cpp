@@ -3,9 +3,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <climits>
 #include <mutex>
+#include <random>
 
 #include "ofn/common/channels.hpp"
 #include "ofn/common/logging.hpp"
@@ -49,6 +51,36 @@ PerHandle<LinkModel>& links() {
   return registry;
 }
 
+// splitmix64's finaliser: every input bit moves every output bit.
+uint64_t mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// Drawn once per process: two runs of a service, or two processes, differ.
+uint64_t process_nonce() {
+  static const uint64_t nonce = [] {
+    std::random_device device;
+    const uint64_t drawn = (static_cast<uint64_t>(device()) << 32) ^ device();
+    return mix(drawn ^ mix(static_cast<uint64_t>(::getpid())) ^
+               static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()));
+  }();
+  return nonce;
+}
+
+uint64_t make_publisher_id(const std::string& name, const Clock& clock) {
+  // The order nodes are made in tells two nodes of one name apart (a test
+  // that restarts a service in one process).
+  static std::atomic<uint64_t> made{0};
+  const uint64_t order = made.fetch_add(1);
+  uint64_t id = clock.deterministic() ? mix(static_cast<uint64_t>(clock.now())) : process_nonce();
+  for (unsigned char c : name) id = mix(id ^ c);
+  id = mix(id ^ order);
+  return id == 0 ? 1 : id;
+}
+
 }  // namespace
 
 void attach_link_model(lcm::LCM& lcm, std::shared_ptr<LinkModel> link) {
@@ -79,6 +111,7 @@ Node::Node(std::string name, lcm::LCM& lcm, const Clock& clock)
       clock_(clock),
       auth_(authenticators().of(lcm)),
       link_(links().of(lcm)),
+      publisher_id_(make_publisher_id(name_, clock)),
       log_(make_logger(name_)),
       period_start_(std::chrono::steady_clock::now()) {
   // A keyring whose policy forgets this service's heartbeat is found at
@@ -131,6 +164,17 @@ void Node::deliver_held(Utime now) {
 void Node::add_subscription(std::unique_ptr<Subscription> sub) {
   sub->handle = lcm_.subscribeFunction(sub->channel, &Node::on_raw, sub.get());
   subscriptions_.push_back(std::move(sub));
+}
+
+SequenceTracker* Node::track_input(const std::string& channel) {
+  const auto [it, added] = sequences_.try_emplace(channel);
+  return added ? &it->second : nullptr;
+}
+
+std::map<std::string, SequenceCounts> Node::input_counts() const {
+  std::map<std::string, SequenceCounts> counts;
+  for (const auto& [channel, tracker] : sequences_) counts.emplace(channel, tracker.counts());
+  return counts;
 }
 
 bool Node::check_time(const std::string& channel, Utime stamp, const SubscribeOptions& options) {
@@ -285,6 +329,18 @@ void Node::publish_heartbeat() {
   hb.loop_time_max = work_max_;
   hb.cpu_fraction = wall_period > 0 ? work_total_ / wall_period : 0.0;
   hb.uptime = start_time_ == INT64_MIN ? 0.0 : to_seconds(clock_.timer_now() - start_time_);
+  for (const auto& [channel, tracker] : sequences_) {
+    const SequenceCounts& c = tracker.counts();
+    channel_counts_t input;
+    input.channel = channel;
+    input.received = c.received;
+    input.lost = c.lost;
+    input.duplicated = c.duplicated;
+    input.unsequenced = c.unsequenced;
+    input.publishers = c.publishers;
+    hb.inputs.push_back(std::move(input));
+  }
+  hb.num_inputs = static_cast<int32_t>(hb.inputs.size());
   publish(heartbeat_channel(name_), hb);
   work_calls_ = 0;
   work_total_ = 0.0;

@@ -282,6 +282,13 @@ std::string validate(const heartbeat_t& m) {
   if (m.service.empty()) return "no service name";
   if (m.unauthenticated < 0 || m.unauthenticated > m.rejected)
     return "unauthenticated count outside 0..rejected";
+  for (const auto& input : m.inputs) {
+    if (input.channel.empty()) return "an input without a channel name";
+    if (input.received < 0 || input.lost < 0 || input.duplicated < 0 || input.publishers < 0 ||
+        input.unsequenced < 0 || input.unsequenced > input.received ||
+        input.duplicated > input.received)
+      return "input counts negative or above the received";
+  }
   return "";
 }
 

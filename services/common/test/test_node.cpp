@@ -432,6 +432,205 @@ TEST_F(NodeTest, AHostileStringLengthIsRejectedAndTheNodeKeepsRunning) {
   EXPECT_EQ(handled_[0].frame, "NED");
 }
 
+// What a publishing node sends, raw: its messages on channel "OUT", kept
+// so that a test can pass them on to TEST_NAV dropped, doubled or in
+// another order, as a bad link would.
+class Relay {
+ public:
+  explicit Relay(lcm::LCM& lcm) : lcm_(lcm) {
+    sub_ = lcm_.subscribeFunction(
+        "OUT",
+        +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Relay* self) {
+          const auto* data = static_cast<const uint8_t*>(rbuf->data);
+          self->sent.emplace_back(data, data + rbuf->data_size);
+        },
+        this);
+  }
+  ~Relay() { lcm_.unsubscribe(sub_); }
+  /// Passes message `i` (0-based, in the order sent) on to TEST_NAV.
+  void pass(size_t i) const {
+    lcm_.publish(kChannel, sent.at(i).data(), static_cast<unsigned>(sent.at(i).size()));
+  }
+  std::vector<std::vector<uint8_t>> sent;
+
+ private:
+  lcm::LCM& lcm_;
+  lcm::Subscription* sub_ = nullptr;
+};
+
+TEST_F(NodeTest, EveryPublishedMessageCarriesItsNodesNumberForTheChannel) {
+  Relay relay(lcm_);
+  std::vector<std::vector<uint8_t>> other;
+  auto* sub = lcm_.subscribeFunction(
+      "OTHER",
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&,
+          std::vector<std::vector<uint8_t>>* out) {
+        const auto* data = static_cast<const uint8_t*>(rbuf->data);
+        out->emplace_back(data, data + rbuf->data_size);
+      },
+      &other);
+  Node node("pub", lcm_, clock_);
+  const nav_state_t m = nav_at(clock_.now());
+  for (int i = 0; i < 3; ++i) node.publish("OUT", m);
+  node.publish("OTHER", m);
+  deliver();
+  lcm_.unsubscribe(sub);
+  ASSERT_EQ(relay.sent.size(), 3u);
+  ASSERT_EQ(other.size(), 1u);
+  for (size_t i = 0; i < 3; ++i) {
+    const auto& bytes = relay.sent[i];
+    ASSERT_EQ(bytes.size(), m.getEncodedSize() + bus_auth::kSequenceTrailerBytes);
+    ASSERT_TRUE(bus_auth::ends_with_sequence_trailer(bytes.data(), bytes.size()));
+    const auto stamp = bus_auth::read_sequence_trailer(bytes.data(), bytes.size());
+    EXPECT_EQ(stamp.publisher, node.publisher_id());
+    EXPECT_EQ(stamp.sequence, i + 1);
+    // LCM's own decoder (lcm-spy's, the Python types') stops at the
+    // message's end.
+    nav_state_t decoded{};
+    EXPECT_EQ(decoded.decode(bytes.data(), 0, static_cast<int>(bytes.size())), m.getEncodedSize());
+  }
+  // Each channel counts from 1.
+  EXPECT_EQ(bus_auth::read_sequence_trailer(other[0].data(), other[0].size()).sequence, 1u);
+  EXPECT_NE(node.publisher_id(), 0u);
+  // Another node, even of the same name, is another publisher.
+  EXPECT_NE(Node("pub", lcm_, clock_).publisher_id(), node.publisher_id());
+}
+
+TEST_F(NodeTest, ADroppedMessageIsCountedAsOneLost) {
+  Relay relay(lcm_);
+  Node& node = subscribed();
+  Node publisher("pub", lcm_, clock_);
+  for (int i = 0; i < 5; ++i) publisher.publish("OUT", nav_at(clock_.now()));
+  deliver();
+  for (size_t i : {0, 1, 3, 4}) relay.pass(i);  // the third never arrives
+  deliver();
+  EXPECT_EQ(handled_.size(), 4u);
+  const SequenceCounts c = node.input_counts().at(kChannel);
+  EXPECT_EQ(c.received, 4);
+  EXPECT_EQ(c.lost, 1);
+  EXPECT_EQ(c.duplicated, 0);
+  EXPECT_EQ(c.unsequenced, 0);
+  EXPECT_EQ(c.publishers, 1);
+}
+
+TEST_F(NodeTest, ADuplicateIsCountedAndAnOvertakenMessageIsNotLost) {
+  Relay relay(lcm_);
+  Node& node = subscribed();
+  Node publisher("pub", lcm_, clock_);
+  for (int i = 0; i < 4; ++i) publisher.publish("OUT", nav_at(clock_.now()));
+  deliver();
+  // 1, 1 again, 3 before 2, 4.
+  for (size_t i : {0, 0, 2, 1, 3}) relay.pass(i);
+  deliver();
+  const SequenceCounts c = node.input_counts().at(kChannel);
+  EXPECT_EQ(c.received, 5);
+  EXPECT_EQ(c.duplicated, 2);  // the copy, and 2 behind 3
+  EXPECT_EQ(c.lost, 0);
+  // Counted, not dropped: the handler sees what the bus delivered.
+  EXPECT_EQ(handled_.size(), 5u);
+}
+
+TEST_F(NodeTest, ARestartedPublisherIsANewOneNotLoss) {
+  Relay relay(lcm_);
+  Node& node = subscribed();
+  {
+    Node first("pub", lcm_, clock_);
+    for (int i = 0; i < 3; ++i) first.publish("OUT", nav_at(clock_.now()));
+    deliver();
+  }
+  clock_.set(clock_.now() + kMicrosPerSecond);
+  Node again("pub", lcm_, clock_);
+  for (int i = 0; i < 2; ++i) again.publish("OUT", nav_at(clock_.now()));
+  deliver();
+  ASSERT_EQ(relay.sent.size(), 5u);
+  for (size_t i = 0; i < 5; ++i) relay.pass(i);
+  deliver();
+  const SequenceCounts c = node.input_counts().at(kChannel);
+  EXPECT_EQ(c.received, 5);
+  EXPECT_EQ(c.lost, 0);
+  EXPECT_EQ(c.duplicated, 0);
+  EXPECT_EQ(c.publishers, 2);
+}
+
+TEST_F(NodeTest, AnUnsequencedMessageIsAcceptedAndCountedAsSuch) {
+  // An older recording, or a publisher that is not a Node: no trailer.
+  Node& node = subscribed();
+  const auto bytes = encoded(nav_at(clock_.now()));
+  lcm_.publish(kChannel, bytes.data(), static_cast<unsigned>(bytes.size()));
+  node.publish(kChannel, nav_at(clock_.now()));
+  deliver();
+  EXPECT_EQ(handled_.size(), 2u);
+  EXPECT_EQ(node.counters().rejected, 0);
+  const SequenceCounts c = node.input_counts().at(kChannel);
+  EXPECT_EQ(c.received, 2);
+  EXPECT_EQ(c.unsequenced, 1);
+  EXPECT_EQ(c.lost, 0);
+  EXPECT_EQ(c.publishers, 1);
+}
+
+TEST_F(NodeTest, AMessageThatFailsValidationStillCountsForItsNumber) {
+  // Rejected for its content, not lost: the next one is no gap.
+  Relay relay(lcm_);
+  Node& node = subscribed();
+  Node publisher("pub", lcm_, clock_);
+  nav_state_t bad = nav_at(clock_.now());
+  bad.position[0] = std::numeric_limits<double>::quiet_NaN();
+  publisher.publish("OUT", nav_at(clock_.now()));
+  publisher.publish("OUT", bad);
+  publisher.publish("OUT", nav_at(clock_.now()));
+  deliver();
+  for (size_t i = 0; i < 3; ++i) relay.pass(i);
+  deliver();
+  EXPECT_EQ(handled_.size(), 2u);
+  EXPECT_EQ(node.counters().rejected, 1);
+  EXPECT_EQ(node.input_counts().at(kChannel).received, 3);
+  EXPECT_EQ(node.input_counts().at(kChannel).lost, 0);
+}
+
+TEST_F(NodeTest, TheHeartbeatReportsEachInputsCounts) {
+  clock_.set(0);
+  Relay relay(lcm_);
+  Node& node = subscribed();
+  node.subscribe<global_path_t>(channels::kGlobalPath, [](const global_path_t&) {});
+  Node publisher("pub", lcm_, clock_);
+  for (int i = 0; i < 4; ++i) publisher.publish("OUT", nav_at(0));
+  deliver();
+  for (size_t i : {0, 2, 3, 3}) relay.pass(i);
+  deliver();
+  Node monitor("monitor", lcm_, clock_);
+  std::vector<heartbeat_t> beats;
+  monitor.subscribe<heartbeat_t>(heartbeat_channel("x"),
+                                 [&](const heartbeat_t& h) { beats.push_back(h); });
+  node.fire_due_timers();
+  deliver();
+  ASSERT_EQ(beats.size(), 1u);
+  const heartbeat_t& hb = beats[0];
+  ASSERT_EQ(hb.num_inputs, 2);
+  // By channel name.
+  EXPECT_EQ(hb.inputs[0].channel, channels::kGlobalPath);
+  EXPECT_EQ(hb.inputs[0].received, 0);
+  EXPECT_EQ(hb.inputs[1].channel, kChannel);
+  EXPECT_EQ(hb.inputs[1].received, 4);
+  EXPECT_EQ(hb.inputs[1].lost, 1);
+  EXPECT_EQ(hb.inputs[1].duplicated, 1);
+  EXPECT_EQ(hb.inputs[1].unsequenced, 0);
+  EXPECT_EQ(hb.inputs[1].publishers, 1);
+  // The monitor counts the heartbeat channel like any input.
+  EXPECT_EQ(monitor.input_counts().at(heartbeat_channel("x")).received, 1);
+}
+
+TEST_F(NodeTest, ASecondSubscriptionToAChannelDoesNotCountItsMessagesTwice) {
+  Node& node = subscribed();
+  int second = 0;
+  node.subscribe<nav_state_t>(kChannel, [&](const nav_state_t&) { ++second; });
+  node.publish(kChannel, nav_at(clock_.now()));
+  deliver();
+  EXPECT_EQ(handled_.size(), 1u);
+  EXPECT_EQ(second, 1);
+  EXPECT_EQ(node.input_counts().at(kChannel).received, 1);
+  EXPECT_EQ(node.input_counts().at(kChannel).duplicated, 0);
+}
+
 }  // namespace
 }  // namespace ofn
 
@@ -514,7 +713,7 @@ TEST_F(AuthenticatedNodeTest, PublishedMessagesAreSignedAndDecodableByLcmsOwnDec
   lcm_.unsubscribe(sub);
   ASSERT_EQ(raw.size(), 1u);
   const auto& bytes = raw.front();
-  EXPECT_EQ(bytes.size(), static_cast<size_t>(sent.getEncodedSize()) + bus_auth::kTrailerBytes);
+  EXPECT_EQ(bytes.size(), static_cast<size_t>(sent.getEncodedSize()) + bus_auth::kMaxTrailerBytes);
   // LCM's decoder reads the message from the front and stops at its end,
   // which is what lcm-spy does with the trailer.
   nav_state_t decoded{};
@@ -524,6 +723,55 @@ TEST_F(AuthenticatedNodeTest, PublishedMessagesAreSignedAndDecodableByLcmsOwnDec
   const auto opened = other_->open("OWN", bytes.data(), bytes.size());
   EXPECT_TRUE(opened.authentic) << opened.reason;
   EXPECT_EQ(opened.role, "a");
+}
+
+TEST_F(AuthenticatedNodeTest, TheSequenceIsSignedAndCountedOnTheAuthenticatedBus) {
+  Node& node = subscribed();
+  // What this node (role a) publishes, as another host receives it.
+  std::vector<std::vector<uint8_t>> raw;
+  auto* sub = lcm_.subscribeFunction(
+      "OWN",
+      +[](const lcm::ReceiveBuffer* rbuf, const std::string&,
+          std::vector<std::vector<uint8_t>>* out) {
+        const auto* data = static_cast<const uint8_t*>(rbuf->data);
+        out->emplace_back(data, data + rbuf->data_size);
+      },
+      &raw);
+  node.publish("OWN", nav_at(clock_.now()));
+  deliver();
+  lcm_.unsubscribe(sub);
+  ASSERT_EQ(raw.size(), 1u);
+  // payload | sequence trailer | authentication trailer
+  auto bytes = raw[0];
+  const size_t payload = static_cast<size_t>(nav_at(0).getEncodedSize());
+  ASSERT_EQ(bytes.size(), payload + bus_auth::kMaxTrailerBytes);
+  const size_t before_signature = bytes.size() - bus_auth::kTrailerBytes;
+  ASSERT_TRUE(bus_auth::ends_with_sequence_trailer(bytes.data(), before_signature));
+  EXPECT_EQ(bus_auth::read_sequence_trailer(bytes.data(), before_signature).sequence, 1u);
+  // A renumbered message (the sequence's last byte) fails the signature;
+  // the message as sent passes.
+  auto renumbered = bytes;
+  renumbered[before_signature - bus_auth::kSequenceTrailerMagic.size() - 1] ^= 0x01;
+  const auto opened = other_->open("OWN", renumbered.data(), renumbered.size());
+  EXPECT_FALSE(opened.authentic);
+  EXPECT_NE(opened.reason.find("bad signature"), std::string::npos) << opened.reason;
+  EXPECT_TRUE(other_->open("OWN", bytes.data(), bytes.size()).authentic);
+
+  // Role b's numbered messages reach this node: 1, 2, then 4.
+  auto numbered = [&](uint64_t sequence) {
+    std::vector<uint8_t> m = encoded(nav_at(clock_.now()));
+    bus_auth::append_sequence_trailer(m, {77, sequence});
+    wall_now_ += 10;
+    other_->seal(kChannel, m);
+    lcm_.publish(kChannel, m.data(), static_cast<unsigned>(m.size()));
+    deliver();
+  };
+  for (uint64_t sequence : {1, 2, 4}) numbered(sequence);
+  EXPECT_EQ(handled_.size(), 3u);
+  const SequenceCounts c = node.input_counts().at(kChannel);
+  EXPECT_EQ(c.received, 3);
+  EXPECT_EQ(c.lost, 1);
+  EXPECT_EQ(c.unsequenced, 0);
 }
 
 TEST_F(AuthenticatedNodeTest, APolicyWithoutTheServiceHeartbeatIsAnErrorAtStart) {
@@ -585,11 +833,11 @@ TEST_F(NodeTest, AMessageOverItsChannelsCapIsRejectedBeforeDecodingAndANormalOne
             1u);
 }
 
-TEST_F(NodeTest, OneByteOverTheCapAndATrailersRoomIsNotDecoded) {
-  // Garbage of the cap's size plus a trailer's is judged by the decoder
+TEST_F(NodeTest, OneByteOverTheCapAndTheTrailersRoomIsNotDecoded) {
+  // Garbage of the cap's size plus both trailers' is judged by the decoder
   // (undecodable); one byte more never reaches it.
   Node& node = subscribed();
-  const size_t limit = max_message_bytes(kChannel) + bus_auth::kTrailerBytes;
+  const size_t limit = max_message_bytes(kChannel) + bus_auth::kMaxTrailerBytes;
   std::vector<uint8_t> junk(limit, 0x5a);
   lcm_.publish(kChannel, junk.data(), static_cast<unsigned>(junk.size()));
   junk.push_back(0x5a);
@@ -610,7 +858,7 @@ TEST(MessageCaps, EveryChannelHasOneAndHeartbeatsShareOne) {
   EXPECT_LT(max_message_bytes("HEARTBEAT_MAPPER"), max_message_bytes(channels::kLidarRaw));
   // A channel the table does not name gets the largest cap.
   EXPECT_EQ(max_message_bytes("SOMETHING_ELSE"), max_message_bytes(channels::kRefTraj));
-  EXPECT_EQ(max_received_bytes(channels::kNavState), 1024u + bus_auth::kTrailerBytes);
+  EXPECT_EQ(max_received_bytes(channels::kNavState), 1024u + bus_auth::kMaxTrailerBytes);
   // Every channel's cap is above its largest message in the flights the
   // table was measured on (message_caps.cpp).
   EXPECT_GT(max_message_bytes(channels::kLidarRaw), 23220u);

@@ -488,6 +488,27 @@ TEST(Validate, OtherTypesRejectTheirBadCases) {
   heartbeat_t h = good_heartbeat();
   h.service = "";
   EXPECT_NE(validate(h), "");
+
+  // Per-channel counts: a name, and none negative or beyond the received.
+  h = good_heartbeat();
+  channel_counts_t input{};
+  input.channel = "NAV_STATE";
+  input.received = 10;
+  input.lost = 3;
+  input.duplicated = 1;
+  input.unsequenced = 2;
+  input.publishers = 1;
+  h.inputs.push_back(input);
+  h.num_inputs = 1;
+  EXPECT_EQ(validate(h), "");
+  h.inputs[0].lost = -1;
+  EXPECT_NE(validate(h), "");
+  h.inputs[0].lost = 3;
+  h.inputs[0].unsequenced = 11;
+  EXPECT_NE(validate(h), "");
+  h.inputs[0].unsequenced = 2;
+  h.inputs[0].channel = "";
+  EXPECT_NE(validate(h), "");
 }
 
 }  // namespace

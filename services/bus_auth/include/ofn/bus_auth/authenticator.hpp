@@ -1,11 +1,13 @@
 #pragma once
 // The authenticated bus: every message a host publishes is signed with the
-// host role's Ed25519 key (libsodium) and carries a sequence number; every
-// receiver checks the signature against the role's public key, the role's
-// right to publish on the channel (the publish policy) and that the
-// sequence is fresh and newer than the last one it accepted from that role
-// on that channel. Ed25519 rather than a shared HMAC key: a host holds only
-// its own secret key, so the ground station cannot sign what only the
+// host role's Ed25519 key (libsodium) and carries a sequence number (the
+// sending host's wall clock, in microseconds); every receiver checks the
+// signature against the role's public key, the role's right to publish on
+// the channel (the publish policy) and that the sequence is fresh and newer
+// than the last one it accepted from that role on that channel. The count
+// of a publisher's messages that shows loss is the sequence trailer's
+// (trailer.hpp), which the signature covers with the payload. Ed25519 rather than a shared HMAC
+// key: a host holds only its own secret key, so the ground station cannot sign what only the
 // onboard computers may publish (REF_TRAJ, ACTUATOR_CMD).
 //
 // Pure core: no LCM, no clock of its own (the caller gives wall time).
@@ -74,7 +76,8 @@ bool valid_role(const std::string& role);
 /// Outcome of checking one received message.
 struct Opened {
   bool authentic = false;
-  /// Bytes of the LCM payload before the trailer (when authentic).
+  /// Bytes before the authentication trailer (when authentic): the LCM
+  /// payload and its sequence trailer, if it has one.
   size_t payload_size = 0;
   /// The signer's role (when the trailer names a known one).
   std::string role;
@@ -124,8 +127,9 @@ class Authenticator {
     return verifier_.policy().may_publish(role_, channel);
   }
 
-  /// Appends the trailer to `message` (an encoded LCM payload) for
-  /// publication on `channel`. Throws KeyError when the policy does not let
+  /// Appends the trailer to `message` (an encoded LCM payload and its
+  /// sequence trailer, ofn/bus_auth/trailer.hpp) for publication on
+  /// `channel`; the signature covers every byte of it. Throws KeyError when the policy does not let
   /// this role publish there: a misconfigured deployment, found at once.
   void seal(const std::string& channel, std::vector<uint8_t>& message);
 

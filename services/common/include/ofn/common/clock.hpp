@@ -90,6 +90,7 @@ class ManualClock final : public Clock {
   explicit ManualClock(Utime start = 0) : now_(start) {}
   Utime now() const override { return now_; }
   double wall_seconds_per_clock_second() const override { return 0.0; }
+  bool deterministic() const override { return true; }
   std::string describe() const override { return "lockstep"; }
   void set(Utime t) { now_ = t; }
 

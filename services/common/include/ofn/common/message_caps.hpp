@@ -1,7 +1,7 @@
 #pragma once
 // The largest message each channel carries, in bytes of the LCM payload: a
-// message larger than its channel's cap (plus, at most, an authentication
-// trailer) is dropped by the Node before it is decoded, counted and logged
+// message larger than its channel's cap (plus, at most, its sequence and
+// authentication trailers) is dropped by the Node before it is decoded, counted and logged
 // as a rejection of kind "oversized". One table for every channel, in
 // message_caps.cpp, with the largest message measured in a flight and the
 // bound each cap leaves above it.
@@ -21,9 +21,10 @@ namespace ofn {
 /// the largest cap of the table.
 size_t max_message_bytes(const std::string& channel);
 
-/// The largest received size `channel` accepts: its cap and room for an
-/// authentication trailer (ofn/bus_auth/trailer.hpp), which an open bus
-/// ignores and an authenticated one requires.
+/// The largest received size `channel` accepts: its cap and room for the
+/// sequence trailer and an authentication trailer
+/// (ofn/bus_auth/trailer.hpp), which an open bus ignores and an
+/// authenticated one requires.
 size_t max_received_bytes(const std::string& channel);
 
 }  // namespace ofn

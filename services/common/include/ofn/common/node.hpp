@@ -19,6 +19,7 @@
 #include "ofn/common/clock.hpp"
 #include "ofn/common/link_model.hpp"
 #include "ofn/common/message_caps.hpp"
+#include "ofn/common/sequence_tracker.hpp"
 
 namespace ofn {
 
@@ -68,9 +69,10 @@ class Node {
 
   /// Subscribes `handler` to `channel`. Every message is checked against
   /// the channel's size cap (ofn/common/message_caps.hpp) before anything
-  /// else, decoded, checked by validate(Msg) (the caller includes
-  /// ofn/common/validate/<message>.hpp of each type it subscribes to) and
-  /// for staleness; a bad one is counted, logged (rate limited) and
+  /// else, decoded, counted by its publisher's sequence number (lost,
+  /// duplicated: input_counts), checked by validate(Msg) (the caller
+  /// includes ofn/common/validate/<message>.hpp of each type it subscribes
+  /// to) and for staleness; a bad one is counted, logged (rate limited) and
   /// dropped, and the handler never sees it.
   template <class Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
@@ -79,10 +81,11 @@ class Node {
     sub->node = this;
     sub->channel = channel;
     sub->deliver = [this, handler = std::move(handler), options, channel,
-                    cap = max_message_bytes(channel)](const lcm::ReceiveBuffer* rbuf) {
-      // Room for a trailer: an open bus ignores one, an authenticated one
-      // requires it.
-      if (rbuf->data_size > cap + bus_auth::kTrailerBytes) {
+                    cap = max_message_bytes(channel),
+                    sequences = track_input(channel)](const lcm::ReceiveBuffer* rbuf) {
+      // Room for the trailers: an open bus reads the sequence and ignores a
+      // signature, an authenticated one requires it.
+      if (rbuf->data_size > cap + bus_auth::kMaxTrailerBytes) {
         reject(channel, "oversized: " + std::to_string(rbuf->data_size) +
                             " bytes, over the channel's cap of " + std::to_string(cap));
         return;
@@ -98,13 +101,22 @@ class Node {
         payload_size = opened.payload_size;
       }
       Msg msg;
+      bus_auth::Trailers trailers;
       // The generated decoders bound counts and lengths by the bytes left
       // (cmake/HardenLcmDecode.cmake); anything they still throw is one bad
       // message, not a reason for the service to die. Without
-      // authentication a trailer is ignored (a replayed authenticated log).
-      if (!bus_auth::decode_payload(msg, rbuf->data, payload_size)) {
+      // authentication a signature is ignored (a replayed authenticated log).
+      if (!bus_auth::decode_payload(msg, rbuf->data, payload_size, &trailers)) {
         reject(channel, "undecodable (" + std::to_string(rbuf->data_size) + " bytes)");
         return;
+      }
+      // Counted whatever validation says of the content: the number says
+      // whether the link lost, copied or reordered it.
+      if (sequences) {
+        if (trailers.sequenced)
+          sequences->on_sequenced(trailers.sequence.publisher, trailers.sequence.sequence);
+        else
+          sequences->on_unsequenced();
       }
       if (std::string why = validate(msg); !why.empty()) {
         reject(channel, why);
@@ -117,22 +129,33 @@ class Node {
     add_subscription(std::move(sub));
   }
 
-  /// Publishes `msg`; on an authenticated bus signed, with its trailer.
+  /// Publishes `msg` with its sequence trailer (this node's publisher id
+  /// and the channel's next number, from 1); on an authenticated bus
+  /// signed, with the authentication trailer after it.
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
     if (link_) link_->published(name_, channel);
-    if (!auth_) {
-      lcm_.publish(channel, &msg);
-      return;
-    }
     const int size = msg.getEncodedSize();
     publish_buffer_.resize(static_cast<size_t>(std::max(size, 0)));
     if (size < 0 || msg.encode(publish_buffer_.data(), 0, size) != size)
       throw std::runtime_error(channel + ": message could not be encoded");
-    auth_->seal(channel, publish_buffer_);
+    bus_auth::append_sequence_trailer(publish_buffer_, {publisher_id_, ++published_[channel]});
+    if (auth_) auth_->seal(channel, publish_buffer_);
     lcm_.publish(channel, publish_buffer_.data(),
                  static_cast<unsigned int>(publish_buffer_.size()));
   }
+
+  /// The id this node's messages carry in their sequence trailer: random
+  /// per process, mixed with the node's name and the order nodes were made
+  /// in, so that a restarted service is a new publisher. Under a
+  /// deterministic clock (lockstep) derived from the name, the clock's time
+  /// when the node was made and that order alone, so runs repeat to the bit.
+  uint64_t publisher_id() const { return publisher_id_; }
+
+  /// Per channel subscribed to: what its publishers' sequence numbers say
+  /// (received, lost, duplicated, unsequenced, publishers), as the heartbeat
+  /// reports it.
+  std::map<std::string, SequenceCounts> input_counts() const;
 
   /// True when this node signs and checks every message (--bus-keys).
   bool authenticated() const { return auth_ != nullptr; }
@@ -189,6 +212,9 @@ class Node {
   void deliver_now(Subscription* sub, const lcm::ReceiveBuffer* rbuf);
   void deliver_held(Utime now);
   void add_subscription(std::unique_ptr<Subscription> sub);
+  /// The sequence counter of a channel's first subscription; nullptr for a
+  /// second one on the same channel (a message is counted once).
+  SequenceTracker* track_input(const std::string& channel);
   bool check_time(const std::string& channel, Utime stamp, const SubscribeOptions& options);
   void publish_heartbeat();
   void account_work(std::chrono::steady_clock::duration busy);
@@ -200,6 +226,9 @@ class Node {
   std::shared_ptr<LinkModel> link_;
   std::multimap<Utime, HeldMessage> held_;  // by due timer time, then arrival
   std::vector<uint8_t> publish_buffer_;
+  uint64_t publisher_id_ = 0;
+  std::map<std::string, uint64_t> published_;         // last sequence number per channel
+  std::map<std::string, SequenceTracker> sequences_;  // per channel subscribed to
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
   std::vector<Timer> timers_;

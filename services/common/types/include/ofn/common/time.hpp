@@ -37,6 +37,11 @@ class Clock {
   /// Wall seconds that pass per clock second; the process loop uses it to
   /// sleep until the next timer. Zero means "time only advances on messages".
   virtual double wall_seconds_per_clock_second() const { return 1.0; }
+  /// True for a clock a program sets (the lockstep scheduler, tests), under
+  /// which a run repeats to the bit: nothing random may then enter what is
+  /// published (a Node's publisher id is derived from its name and this
+  /// clock's time instead).
+  virtual bool deterministic() const { return false; }
   virtual std::string describe() const = 0;
 };
 
