@@ -4,7 +4,9 @@
 // see ArrivalWatch) or when the wall-clock timeout passes (1). The launcher
 // uses it to end a run. It also says which services have fallen silent (no
 // heartbeat for --silence wall seconds, see HeartbeatWatch) and when they
-// are heard again.
+// are heard again, and, with each progress line, which services' inputs
+// lost or duplicated messages since the last (their heartbeats' counts of
+// the publishers' sequence numbers, see InputLossTally).
 
 #include <chrono>
 #include <cmath>
@@ -31,6 +33,7 @@
 #include "ofn/nav_state_t.hpp"
 #include "ofn/tools/arrival_watch.hpp"
 #include "ofn/tools/heartbeat_watch.hpp"
+#include "ofn/tools/input_loss.hpp"
 #include "ofn/tools/monitor_line.hpp"
 
 int main(int argc, char** argv) {
@@ -106,19 +109,24 @@ int main(int argc, char** argv) {
           }
           mode = m.mode;
         });
+    ofn::report::InputLossTally loss;
     node.add_timer(
         report_period,
         [&] {
           if (!nav) {
             std::cout << "monitor: waiting for NAV_STATE" << std::endl;
-            return;
+          } else {
+            std::cout << "monitor: "
+                      << ofn::report::progress_line(
+                             ofn::to_seconds(nav->utime), ofn::to_vec3(nav->position),
+                             ofn::to_vec3(nav->velocity),
+                             mode < 0 ? "-" : ofn::control_mode_name(mode), unit)
+                      << std::endl;
           }
-          std::cout << "monitor: "
-                    << ofn::report::progress_line(
-                           ofn::to_seconds(nav->utime), ofn::to_vec3(nav->position),
-                           ofn::to_vec3(nav->velocity),
-                           mode < 0 ? "-" : ofn::control_mode_name(mode), unit)
-                    << std::endl;
+          // Loss is shown when there is some: per service, each input that
+          // lost or duplicated more since the last line, with its totals.
+          for (const auto& line : ofn::report::growth_lines(loss.grown()))
+            std::cout << "monitor: messages lost: " << line << std::endl;
         },
         "progress");
     const auto wall_start = std::chrono::steady_clock::now();
@@ -126,16 +134,15 @@ int main(int argc, char** argv) {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     };
     std::optional<ofn::report::HeartbeatWatch> heartbeats;
-    if (silence > 0) {
-      heartbeats.emplace(silence);
-      for (const std::string& service : watched)
-        node.subscribe<ofn::heartbeat_t>(
-            ofn::heartbeat_channel(service),
-            [&heartbeats, &wall_seconds, service](const ofn::heartbeat_t&) {
-              heartbeats->heard(service, wall_seconds());
-            },
-            ofn::SubscribeOptions{0.0, 0.0});
-    }
+    if (silence > 0) heartbeats.emplace(silence);
+    for (const std::string& service : watched)
+      node.subscribe<ofn::heartbeat_t>(
+          ofn::heartbeat_channel(service),
+          [&heartbeats, &loss, &wall_seconds, service](const ofn::heartbeat_t& m) {
+            if (heartbeats) heartbeats->heard(service, wall_seconds());
+            loss.heard(m);
+          },
+          ofn::SubscribeOptions{0.0, 0.0});
     auto names = [](const std::vector<std::string>& list) {
       std::ostringstream out;
       for (size_t i = 0; i < list.size(); ++i) out << (i ? ", " : "") << list[i];

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -31,6 +32,7 @@
 #include "ofn/ref_traj_t.hpp"
 #include "ofn/scan_world_t.hpp"
 #include "ofn/solver_stats_t.hpp"
+#include "ofn/tools/input_loss.hpp"
 #include "ofn/world/world.hpp"
 
 namespace ofn::report {
@@ -46,7 +48,8 @@ std::optional<double> percentile(std::vector<double> values, double q) {
   return values[i];
 }
 
-// A message alone, or with the trailer of an authenticated bus.
+// A message alone, or with its sequence trailer, the trailer of an
+// authenticated bus, or both.
 template <class Msg>
 bool decode(const lcm::LogEvent& e, Msg& out) {
   return e.datalen >= 0 && bus_auth::decode_payload(out, e.data, static_cast<size_t>(e.datalen));
@@ -109,6 +112,8 @@ struct FlightRecord {
   // Scan-to-plan latency: every map's stamp, and every step that planned.
   std::vector<double> map_stamps;
   std::vector<PlanStep> plan_steps;
+  // What each service's heartbeats say it received, lost and duplicated.
+  InputLossTally inputs;
 
   int count(int solver_status) const {
     const auto it = solver_status_count.find(solver_status);
@@ -133,7 +138,9 @@ class CsvTables {
                           "t [s],collective [rad],lon_cyclic [rad],lat_cyclic [rad],pedal [rad]")),
         heartbeat_(open_csv(out / "heartbeats.csv",
                             "t [s],service,state,received,rejected,late,loop_time_mean [s],"
-                            "loop_time_max [s],cpu_fraction,unauthenticated")),
+                            "loop_time_max [s],cpu_fraction,unauthenticated,lost,duplicated")),
+        inputs_(open_csv(out / "inputs.csv",
+                         "t [s],service,channel,received,lost,duplicated,unsequenced,publishers")),
         scan_(open_csv(out / "scan_points.csv", "t [s],north [m],east [m],down [m]")),
         path_(open_csv(out / "global_path.csv",
                        "t [s],seq,status,cost [m],north [m],east [m],down [m]")),
@@ -187,10 +194,21 @@ class CsvTables {
            << "," << m.max_constraint_violation << "," << m.cost << "," << (m.warm_started ? 1 : 0)
            << "\n";
   }
+  // One row per heartbeat, lost and duplicated summed over its inputs;
+  // one row per input in inputs.csv.
   void heartbeat(double t, const heartbeat_t& m) {
+    int64_t lost = 0, duplicated = 0;
+    for (const auto& in : m.inputs) {
+      lost += in.lost;
+      duplicated += in.duplicated;
+      inputs_ << t << "," << csv_text(m.service) << "," << csv_text(in.channel) << ","
+              << in.received << "," << in.lost << "," << in.duplicated << "," << in.unsequenced
+              << "," << in.publishers << "\n";
+    }
     heartbeat_ << t << "," << csv_text(m.service) << "," << csv_text(m.state) << "," << m.received
                << "," << m.rejected << "," << m.late << "," << m.loop_time_mean << ","
-               << m.loop_time_max << "," << m.cpu_fraction << "," << m.unauthenticated << "\n";
+               << m.loop_time_max << "," << m.cpu_fraction << "," << m.unauthenticated << ","
+               << lost << "," << duplicated << "\n";
   }
 
   static void waypoints(const std::filesystem::path& out, const std::optional<mission_t>& mission) {
@@ -224,7 +242,7 @@ class CsvTables {
     for (const auto& v : vs) f << "," << v.x() << "," << v.y() << "," << v.z();
   }
 
-  std::ofstream nav_, status_, command_, heartbeat_, scan_, path_, ref_, stats_;
+  std::ofstream nav_, status_, command_, heartbeat_, inputs_, scan_, path_, ref_, stats_;
   size_t scan_points_written_ = 0;
   int ref_seen_ = 0, ref_seq_ = 0;
 };
@@ -279,7 +297,10 @@ class LogDecoder {
     if (channel == channels::kMission)
       return on<mission_t>(e, [this](auto& m) { record_.mission = m; });
     if (channel.rfind(channels::kHeartbeatPrefix, 0) == 0)
-      return on<heartbeat_t>(e, [this](auto& m) { tables_.heartbeat(rel(m.utime), m); });
+      return on<heartbeat_t>(e, [this](auto& m) {
+        tables_.heartbeat(rel(m.utime), m);
+        record_.inputs.heard(m);
+      });
     return Outcome::kRead;  // a channel the report does not read
   }
 
@@ -480,6 +501,17 @@ nlohmann::ordered_json summary_json(const FlightRecord& record, const Judged& j,
       {"undecodable", result.undecodable},
       {"invalid", result.invalid},
       {"unauthenticated", result.authenticated ? Json(result.unauthenticated) : Json(nullptr)}};
+  // Per service and input channel, from the heartbeats (the last of each
+  // process, added up over restarts): the publishers' sequence numbers.
+  json["inputs"] = Json::array();
+  for (const InputTotal& in : record.inputs.totals())
+    json["inputs"].push_back({{"service", in.service},
+                              {"channel", in.channel},
+                              {"received", in.counts.received},
+                              {"lost", in.counts.lost},
+                              {"duplicated", in.counts.duplicated},
+                              {"unsequenced", in.counts.unsequenced},
+                              {"publishers", in.counts.publishers}});
   json["crossed_finish"] = s.crossed_finish;
   json["duration"] = s.duration;
   json["max_speed"] = s.max_speed;
@@ -542,6 +574,38 @@ nlohmann::ordered_json summary_json(const FlightRecord& record, const Judged& j,
                                    {"appear_time", o.appear_time},
                                    {"disappear_time", o.disappear_time}});
   return json;
+}
+
+/// "1 input", "2 inputs".
+std::string count_of(size_t n, const std::string& thing) {
+  return std::to_string(n) + " " + thing + (n == 1 ? "" : "s");
+}
+
+/// The loss line of the summary: none, or each input that lost or
+/// duplicated messages on a line of its own. Nothing for a log whose
+/// heartbeats carry no input counts (recorded before they did).
+void input_loss_text(const std::vector<InputTotal>& inputs, std::ostringstream& t) {
+  if (inputs.empty()) return;
+  int64_t lost = 0, sent = 0;
+  std::set<std::string> services;
+  std::vector<const InputTotal*> shown;
+  for (const InputTotal& in : inputs) {
+    lost += in.counts.lost;
+    sent += sequenced_sent(in.counts);
+    services.insert(in.service);
+    if (in.counts.lost > 0 || in.counts.duplicated > 0) shown.push_back(&in);
+  }
+  t << "  messages lost     : ";
+  if (shown.empty()) {
+    t << "none (" << count_of(inputs.size(), "input") << " of "
+      << count_of(services.size(), "service") << ", by their heartbeats)\n";
+    return;
+  }
+  t << lost << " of " << sent << " numbered messages, on " << shown.size() << " of "
+    << count_of(inputs.size(), "input") << " of " << count_of(services.size(), "service")
+    << " (by their heartbeats; inputs.csv):";
+  for (const InputTotal* in : shown) t << "\n                      " << describe(*in);
+  t << "\n";
 }
 
 std::string summary_text(const FlightRecord& record, const Judged& j, const ReportResult& result,
@@ -637,6 +701,7 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
       << " scans while avoiding (a scan's stamp to the first RH step on a map holding it)\n"
       << std::setprecision(2);
   if (record.paths > 0) t << "  global planner    : " << record.paths << " paths published\n";
+  input_loss_text(record.inputs.totals(), t);
   if (result.undecodable)
     t << "  warning           : " << result.undecodable << " undecodable messages skipped\n";
   if (result.authenticated)
@@ -648,7 +713,7 @@ std::string summary_text(const FlightRecord& record, const Judged& j, const Repo
       << " invalid messages skipped, as the services skip them (first: " << result.first_invalid
       << ")\n";
   t << "  files             : " << out.string() << "/{nav_state,control_status,actuator_cmd,"
-    << "heartbeats,waypoints,scan_points,cuboids,global_path,ref_traj,solver_stats}.csv, "
+    << "heartbeats,inputs,waypoints,scan_points,cuboids,global_path,ref_traj,solver_stats}.csv, "
     << "summary.json\n";
   return t.str();
 }

@@ -155,6 +155,105 @@ TEST_F(FlightReport, AHoverIsTabledAndSummarised) {
   EXPECT_EQ(json.at("obstacles").size(), open.obstacles.size());
 }
 
+// Numbered messages read as before; the heartbeats' input counts are
+// tabled, totalled over a restart and shown when something was lost.
+TEST_F(FlightReport, LossTheHeartbeatsCountIsTabledAndShown) {
+  const Scenario open = load_scenario(kOpenScenario);
+  const std::string path = (dir_ / "numbered.lcm").string();
+  {
+    lcm::LogFile log(path, "w");
+    ASSERT_TRUE(log.good());
+    const Utime t0 = 1000 * kMicrosPerSecond;
+    for (int i = 0; i <= 200; ++i) {
+      nav_state_t nav{};
+      nav.utime = t0 + i * 10000;
+      nav.frame = "NED";
+      for (int k = 0; k < 3; ++k) nav.position[k] = open.start_position[k];
+      nav.quaternion[0] = 1.0;
+      auto bytes = encoded(nav);
+      bus_auth::append_sequence_trailer(bytes, {99, static_cast<uint64_t>(i + 1)});
+      write_bytes(log, channels::kNavState, bytes, nav.utime);
+    }
+    auto beat = [&](int32_t pid, int64_t received, int64_t lost, Utime t) {
+      heartbeat_t hb{};
+      hb.utime = t;
+      hb.service = "mapper";
+      hb.pid = pid;
+      hb.state = "running";
+      channel_counts_t in{};
+      in.channel = channels::kNavState;
+      in.received = received;
+      in.lost = lost;
+      in.publishers = 1;
+      channel_counts_t quiet = in;
+      quiet.channel = channels::kScanWorld;
+      quiet.lost = 0;
+      hb.inputs = {in, quiet};
+      hb.num_inputs = 2;
+      write(log, std::string(channels::kHeartbeatPrefix) + "MAPPER", hb, t);
+    };
+    beat(10, 90, 10, t0 + kMicrosPerSecond);
+    beat(11, 45, 5, t0 + 2 * kMicrosPerSecond);  // restarted: counts from zero
+  }
+  const fs::path out = dir_ / "report";
+  const ReportResult result = write_flight_report(path, out.string(), open, PseudoControlBound{});
+  EXPECT_EQ(result.undecodable, 0u);
+  EXPECT_NEAR(result.summary.duration, 2.0, 1e-9);
+  // One row per heartbeat and input; the heartbeat's row sums its inputs.
+  EXPECT_EQ(lines_of(out / "inputs.csv"), 1u + 4u);
+  std::ifstream heartbeats(out / "heartbeats.csv");
+  std::string header, first;
+  std::getline(heartbeats, header);
+  std::getline(heartbeats, first);
+  EXPECT_EQ(header.substr(header.size() - std::string(",lost,duplicated").size()),
+            ",lost,duplicated");
+  EXPECT_EQ(first.substr(first.size() - 5), ",10,0") << first;
+  // Totals over both processes.
+  const nlohmann::json json = read_json(out / "summary.json");
+  ASSERT_EQ(json.at("inputs").size(), 2u);
+  EXPECT_EQ(json.at("inputs")[0].at("channel"), channels::kNavState);
+  EXPECT_EQ(json.at("inputs")[0].at("received"), 135);
+  EXPECT_EQ(json.at("inputs")[0].at("lost"), 15);
+  EXPECT_EQ(json.at("inputs")[1].at("lost"), 0);
+  EXPECT_NE(result.text.find("messages lost     : 15 of 285 numbered messages, on 1 of 2 inputs "
+                             "of 1 service (by their heartbeats; inputs.csv):"),
+            std::string::npos)
+      << result.text;
+  EXPECT_NE(result.text.find("mapper NAV_STATE: 15 of 150 lost (10.0 %)"), std::string::npos)
+      << result.text;
+  EXPECT_EQ(result.text.find("mapper SCAN_WORLD"), std::string::npos) << result.text;
+}
+
+TEST_F(FlightReport, NoLossSaysNoneAndALogWithoutCountsSaysNothing) {
+  const Scenario open = load_scenario(kOpenScenario);
+  // hover_log's heartbeat carries no inputs (as one recorded before they did).
+  const std::string plain = hover_log("hover.lcm", open.start_position, 1.0);
+  const ReportResult before =
+      write_flight_report(plain, (dir_ / "before").string(), open, PseudoControlBound{});
+  EXPECT_EQ(before.text.find("messages lost"), std::string::npos) << before.text;
+  EXPECT_TRUE(read_json(dir_ / "before" / "summary.json").at("inputs").empty());
+  {
+    lcm::LogFile log(plain, "a");
+    heartbeat_t hb{};
+    hb.utime = 1000 * kMicrosPerSecond;
+    hb.service = "controller";
+    hb.state = "running";
+    channel_counts_t in{};
+    in.channel = channels::kNavState;
+    in.received = 100;
+    in.publishers = 1;
+    hb.inputs = {in};
+    hb.num_inputs = 1;
+    write(log, std::string(channels::kHeartbeatPrefix) + "CONTROLLER", hb, hb.utime);
+  }
+  const ReportResult after =
+      write_flight_report(plain, (dir_ / "after").string(), open, PseudoControlBound{});
+  EXPECT_NE(after.text.find("messages lost     : none (1 input of 1 service, by their "
+                            "heartbeats)"),
+            std::string::npos)
+      << after.text;
+}
+
 // With the controller's stops the summary says how much of the flight a
 // control was at one; without them it says nothing (null), not zero.
 TEST_F(FlightReport, ControlsAtAStopAreSharesOfTheCommands) {
