@@ -51,6 +51,11 @@ int main(int argc, char** argv) {
     // run fell short of its real-time factor.
     service.node().log().info("the clock waited {:.2f} s of wall time for the simulator",
                               clock.paused());
+    if (service.failsafe().enabled())
+      service.node().log().info(
+          "the airframe's stabiliser took over {} times (each after {:.2f} s without an actuator "
+          "command)",
+          service.failsafe().takeovers(), config.command_timeout);
     return code;
   });
 }

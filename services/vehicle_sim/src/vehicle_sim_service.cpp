@@ -68,7 +68,7 @@ VehicleSimConfig load_vehicle_sim_config(YamlReader& r) {
   VehicleSimConfig c;
   c.physics_rate = r.number_in("physics_rate_hz", c.physics_rate, 200.0, 5000.0);
   c.nav_rate = r.number_in("nav_rate_hz", c.nav_rate, 10.0, 1000.0);
-  c.command_timeout = r.number_in("command_timeout", c.command_timeout, 0.01, 60.0);
+  c.command_timeout = r.number_in("command_timeout", c.command_timeout, 0.0, 60.0);
   c.hold_until_engaged = r.boolean("hold_until_engaged", c.hold_until_engaged);
   c.engage_timeout = r.number_in("engage_timeout", c.engage_timeout, 0.0, 3600.0);
   c.checkpoint_period = r.number_in("checkpoint_period", c.checkpoint_period, 0.01, 60.0);
@@ -101,6 +101,9 @@ VehicleSimService::VehicleSimService(lcm::LCM& lcm, const Clock& clock, const Sc
       real_time_factor_(real_time_factor),
       vehicle_(apply_variation(config_.params, scenario.vehicle), scenario.wind,
                scenario.disturbances, scenario.ground_altitude),
+      // The airframe's stabiliser is built for the configured airframe; a
+      // scenario's variation is what it flies.
+      failsafe_(config_.params, config_.command_timeout),
       world_({}, scenario.ground_altitude),
       lidar_(config_.lidar, scenario.limits.sensor_range) {
   const TrimResult t =
@@ -167,6 +170,11 @@ void VehicleSimService::on_command(const actuator_cmd_t& m) {
     return;
   }
   last_command_time_ = node_.now();
+  if (failsafe_.command_received(to_seconds(last_command_time_)))
+    node_.log().info(
+        "actuator commands again at t={:.2f} s: the airframe's stabiliser hands back after "
+        "{:.2f} s",
+        to_seconds(last_command_time_), to_seconds(last_command_time_) - failsafe_.engaged_since());
   // Until released the vehicle flies its trim, whatever the controller says.
   if (released_) vehicle_.set_command(command);
 }
@@ -251,6 +259,16 @@ void VehicleSimService::step_physics() {
   // stamped with the time it is valid for.
   while (state_time_ + dt_us <= now) {
     if (released_) {
+      // No command for command_timeout: the airframe's own stabiliser flies.
+      const int takeovers = failsafe_.takeovers();
+      if (const auto c = failsafe_.update(to_seconds(state_time_), vehicle_.model().state()))
+        vehicle_.set_command(*c);
+      if (failsafe_.takeovers() != takeovers)
+        node_.log().warn(
+            "no actuator command for {:.2f} s at t={:.2f} s: the airframe's stabiliser takes "
+            "over (takeover {}), levelling and slowing to a hover",
+            to_seconds(state_time_ - last_command_time_), to_seconds(state_time_),
+            failsafe_.takeovers());
       vehicle_.step(to_seconds(dt_us));
     } else {
       // Held: trimmed flight frozen at the start point.
@@ -264,9 +282,15 @@ void VehicleSimService::step_physics() {
       while (auto scan = lidar_.take_completed_scan()) publish_scan(*scan);
     }
   }
-  const bool commanded = last_command_time_ != INT64_MIN &&
-                         now - last_command_time_ <= to_utime(config_.command_timeout);
-  node_.set_state(!released_ ? "holding" : commanded ? "running" : "degraded");
+  // Commands older than the failsafe's timeout (0.5 s without a failsafe)
+  // are reported, and the stabiliser's flight is.
+  const double silent_after = config_.command_timeout > 0 ? config_.command_timeout : 0.5;
+  const bool commanded =
+      last_command_time_ != INT64_MIN && now - last_command_time_ <= to_utime(silent_after);
+  node_.set_state(!released_            ? "holding"
+                  : failsafe_.engaged() ? "failsafe"
+                  : commanded           ? "running"
+                                        : "degraded");
 }
 
 void VehicleSimService::publish_nav() {

@@ -4,6 +4,8 @@
 // out. Physics and the scanner run on a fixed-step timer of the node's clock.
 // The scenario sets the airframe's deviation from the configured one, the
 // wind and turbulence, and the navigation solution's noise and latency.
+// When ACTUATOR_CMD stops, the airframe's own stabiliser flies it
+// (AirframeFailsafe) until commands come again.
 
 #include <functional>
 #include <optional>
@@ -14,6 +16,7 @@
 #include "ofn/common/node.hpp"
 #include "ofn/common/scenario.hpp"
 #include "ofn/control_status_t.hpp"
+#include "ofn/vehicle_sim/airframe_failsafe.hpp"
 #include "ofn/vehicle_sim/checkpoint.hpp"
 #include "ofn/vehicle_sim/disturbances.hpp"
 #include "ofn/vehicle_sim/lidar_head.hpp"
@@ -24,9 +27,12 @@
 namespace ofn::vehicle {
 
 struct VehicleSimConfig {
-  double physics_rate = 400.0;   // Hz, fixed integration step
-  double nav_rate = 100.0;       // Hz, NAV_STATE and SIM_CLOCK
-  double command_timeout = 0.5;  // s without ACTUATOR_CMD before the service reports degraded
+  double physics_rate = 400.0;  // Hz, fixed integration step
+  double nav_rate = 100.0;      // Hz, NAV_STATE and SIM_CLOCK
+  /// s without a valid ACTUATOR_CMD before the airframe's stabiliser takes
+  /// over (armed by the first command; the heartbeat then says
+  /// "failsafe"); 0: no failsafe, the airframe flies the last command.
+  double command_timeout = 0.2;
   /// Hold the vehicle in trimmed flight at its start state (the clock still
   /// runs) until the controller reports a mission (it then commands the
   /// vehicle in every mode), as a flight test begins when the autopilot is
@@ -65,6 +71,7 @@ class VehicleSimService {
   const world::World& world() const { return world_; }
   const LidarHead& lidar() const { return lidar_; }
   int64_t scans_published() const { return scans_published_; }
+  const AirframeFailsafe& failsafe() const { return failsafe_; }
 
  private:
   void on_command(const actuator_cmd_t& msg);
@@ -78,6 +85,7 @@ class VehicleSimService {
   VehicleSimConfig config_;
   double real_time_factor_;
   SimulatedVehicle vehicle_;
+  AirframeFailsafe failsafe_;
   RotorcraftState start_state_;
   Controls trim_controls_;
   Utime state_time_ = INT64_MIN;
