@@ -860,7 +860,7 @@ TEST(MessageCaps, EveryChannelHasOneAndHeartbeatsShareOne) {
   EXPECT_EQ(max_message_bytes("SOMETHING_ELSE"), max_message_bytes(channels::kRefTraj));
   EXPECT_EQ(max_received_bytes(channels::kNavState), 1024u + bus_auth::kMaxTrailerBytes);
   // Every channel's cap is above its largest message in the flights the
-  // table was measured on (message_caps.cpp).
+  // table was measured on (channel_table.cpp).
   EXPECT_GT(max_message_bytes(channels::kLidarRaw), 23220u);
   EXPECT_GT(max_message_bytes(channels::kScanWorld), 16384u);
   EXPECT_GT(max_message_bytes(channels::kObstacleGrid), 55764u);

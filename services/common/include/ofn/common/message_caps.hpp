@@ -2,9 +2,9 @@
 // The largest message each channel carries, in bytes of the LCM payload: a
 // message larger than its channel's cap (plus, at most, its sequence and
 // authentication trailers) is dropped by the Node before it is decoded, counted and logged
-// as a rejection of kind "oversized". One table for every channel, in
-// message_caps.cpp, with the largest message measured in a flight and the
-// bound each cap leaves above it.
+// as a rejection of kind "oversized". The caps are the channel table's
+// (ofn/common/channel_table.hpp), with the largest message measured in a
+// flight and the bound each cap leaves above it.
 //
 // LCM itself has received the whole message by then (it reassembles the
 // datagrams of a large one into a buffer of the announced size): the cap
