@@ -184,9 +184,12 @@ bool Node::check_time(const std::string& channel, Utime stamp, const SubscribeOp
     reject(channel, "stamped " + std::to_string(to_seconds(stamp - now)) + " s in the future");
     return false;
   }
-  if (options.max_age > 0 && now - stamp > to_utime(options.max_age)) {
+  // Compared without `now - stamp`, which overflows for a stamp near
+  // INT64_MIN (and then passed as fresh).
+  if (options.max_age > 0 && stamp < now - to_utime(options.max_age)) {
     ++counters_.late;
-    reject(channel, "stale by " + std::to_string(to_seconds(now - stamp)) + " s");
+    const double age = (static_cast<double>(now) - static_cast<double>(stamp)) * 1e-6;
+    reject(channel, "stale by " + std::to_string(age) + " s");
     return false;
   }
   return true;

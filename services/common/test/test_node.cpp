@@ -138,6 +138,22 @@ TEST_F(NodeTest, StaleMessageIsRejectedAndCountedLate) {
   EXPECT_EQ(node.counters().late, 1);
 }
 
+TEST_F(NodeTest, TheFarthestStampsEitherWayAreRejected) {
+  // -2^63 is as stale as a stamp can be; `now - stamp` overflowed for it,
+  // and it passed as fresh (found by the bus fuzz).
+  SubscribeOptions options;
+  options.max_age = 0.2;
+  Node& node = subscribed(options);
+  for (Utime stamp : {INT64_MIN, INT64_MIN + 1, Utime{-1}, INT64_MAX}) {
+    node.publish(kChannel, nav_at(stamp));
+    deliver();
+  }
+  EXPECT_TRUE(handled_.empty());
+  EXPECT_EQ(node.counters().rejected, 4);
+  EXPECT_EQ(node.counters().late, 3);
+  EXPECT_NE(node.counters().last_reject_reason.find("in the future"), std::string::npos);
+}
+
 TEST_F(NodeTest, WithoutMaxAgeOldMessagesAreAccepted) {
   Node& node = subscribed();  // max_age 0: no staleness check
   node.publish(kChannel, nav_at(0));
