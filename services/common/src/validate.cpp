@@ -91,6 +91,9 @@ std::string validate(const virtual_obstacles_t& m) {
     if (o.kind < obstacle_t::BOX || o.kind > obstacle_t::TREE) return "unknown obstacle kind";
     const double v[5] = {o.center[0], o.center[1], o.size[0], o.size[1], o.height};
     if (!all_finite(v) || !std::isfinite(o.yaw)) return "obstacle not finite";
+    // Negative is "always there" / "never goes"; NaN would be neither.
+    if (!std::isfinite(o.appear_time) || !std::isfinite(o.disappear_time))
+      return "obstacle schedule not finite";
     if (o.size[0] <= 0 || o.size[1] <= 0 || o.height <= 0) return "obstacle size not positive";
   }
   return "";
@@ -162,6 +165,7 @@ std::string validate(const cuboid_list_t& m) {
     return e;
   for (const auto& c : m.cuboids) {
     if (!within_world(c.min_corner) || !within_world(c.max_corner)) return "cuboid not finite";
+    if (!std::isfinite(c.confidence)) return "cuboid confidence not finite";
     for (int k = 0; k < 3; ++k)
       if (c.min_corner[k] > c.max_corner[k]) return "cuboid min corner above max corner";
   }
@@ -174,6 +178,7 @@ std::string validate(const global_path_t& m) {
       !e.empty())
     return e;
   if (m.status < global_path_t::OK || m.status > global_path_t::BACKTRACK) return "unknown status";
+  if (!std::isfinite(m.cost)) return "path cost not finite";
   for (const auto& p : m.points)
     if (p.size() != 3 || !all_finite(p.begin(), p.end())) return "path point not finite";
   return "";
@@ -272,7 +277,8 @@ std::string validate(const solver_stats_t& m) {
 std::string validate(const control_status_t& m) {
   if (!all_finite(m.ref_position) || !all_finite(m.ref_velocity) ||
       !all_finite(m.ref_acceleration) || !all_finite(m.commanded_acceleration) ||
-      !all_finite(m.position_error) || !all_finite(m.adaptive_output))
+      !all_finite(m.position_error) || !all_finite(m.adaptive_output) ||
+      !std::isfinite(m.yaw_reference))
     return "status not finite";
   if (m.active_waypoint < -1) return "active waypoint below -1";
   return "";
@@ -282,6 +288,8 @@ std::string validate(const heartbeat_t& m) {
   if (m.service.empty()) return "no service name";
   if (m.unauthenticated < 0 || m.unauthenticated > m.rejected)
     return "unauthenticated count outside 0..rejected";
+  const double v[4] = {m.loop_time_mean, m.loop_time_max, m.cpu_fraction, m.uptime};
+  if (!all_finite(v)) return "loop times, CPU or uptime not finite";
   for (const auto& input : m.inputs) {
     if (input.channel.empty()) return "an input without a channel name";
     if (input.received < 0 || input.lost < 0 || input.duplicated < 0 || input.publishers < 0 ||

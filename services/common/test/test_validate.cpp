@@ -511,5 +511,38 @@ TEST(Validate, OtherTypesRejectTheirBadCases) {
   EXPECT_NE(validate(h), "");
 }
 
+// Every float of every type is checked: the bus fuzz found these fields
+// passed with NaN or Inf in them (tests/fuzz).
+TEST(Validate, NonFiniteNumbersOutsideTheGeometryAreRejectedToo) {
+  virtual_obstacles_t o = good_obstacles();
+  o.obstacles[0].appear_time = kNaN;
+  EXPECT_EQ(validate(o), "obstacle schedule not finite");
+  o = good_obstacles();
+  o.obstacles[0].disappear_time = kInf;
+  EXPECT_EQ(validate(o), "obstacle schedule not finite");
+  o = good_obstacles();
+  o.obstacles[0].appear_time = -1.0;  // always there
+  EXPECT_EQ(validate(o), "");
+
+  cuboid_list_t cl = good_cuboids();
+  cl.cuboids[0].confidence = kNaN;
+  EXPECT_EQ(validate(cl), "cuboid confidence not finite");
+
+  global_path_t p = good_path();
+  p.cost = -kInf;
+  EXPECT_EQ(validate(p), "path cost not finite");
+
+  control_status_t st = good_status();
+  st.yaw_reference = kNaN;
+  EXPECT_EQ(validate(st), "status not finite");
+
+  for (double heartbeat_t::*field : {&heartbeat_t::loop_time_mean, &heartbeat_t::loop_time_max,
+                                     &heartbeat_t::cpu_fraction, &heartbeat_t::uptime}) {
+    heartbeat_t h = good_heartbeat();
+    h.*field = kInf;
+    EXPECT_EQ(validate(h), "loop times, CPU or uptime not finite");
+  }
+}
+
 }  // namespace
 }  // namespace ofn
