@@ -73,21 +73,39 @@ void Mapper::trace_over_tops(const Vec3& origin, const Vec3& end, double min_con
   const double gn = (origin.x() - raw.origin_north) / res,
                ge = (origin.y() - raw.origin_east) / res;
   const double dn = (end.x() - origin.x()) / res, de = (end.y() - origin.y()) / res;
-  int row = static_cast<int>(std::floor(gn)), col = static_cast<int>(std::floor(ge));
+  // Only the part of the beam over the grid is walked (t in [t_in, t_out]
+  // of its length): a beam of any length, or from a sensor anywhere, walks
+  // at most the grid's rows + cols cells.
+  double t_in = 0.0, t_out = 1.0;
+  const auto clip = [&t_in, &t_out](double g, double d, int cells) {
+    if (d == 0) return g >= 0 && g < cells;
+    const double ta = (0 - g) / d, tb = (cells - g) / d;
+    t_in = std::max(t_in, std::min(ta, tb));
+    t_out = std::min(t_out, std::max(ta, tb));
+    return true;
+  };
+  if (!std::isfinite(gn + ge + dn + de) || !clip(gn, dn, raw.rows) || !clip(ge, de, raw.cols) ||
+      !(t_in < t_out))
+    return;
+  const double sn = gn + t_in * dn, se = ge + t_in * de;
+  int row = std::clamp(static_cast<int>(std::floor(sn)), 0, raw.rows - 1);
+  int col = std::clamp(static_cast<int>(std::floor(se)), 0, raw.cols - 1);
   const int step_r = dn > 0 ? 1 : -1, step_c = de > 0 ? 1 : -1;
   const double inf = std::numeric_limits<double>::infinity();
   const double dt_r = dn != 0 ? std::abs(1.0 / dn) : inf;
   const double dt_c = de != 0 ? std::abs(1.0 / de) : inf;
   double t_r = dn > 0 ? (row + 1 - gn) * dt_r : dn < 0 ? (gn - row) * dt_r : inf;
   double t_c = de > 0 ? (col + 1 - ge) * dt_c : de < 0 ? (ge - col) * dt_c : inf;
-  double t_enter = 0;
+  // The sensor's own cell is not one the beam left; a cell it entered from
+  // outside the grid is.
+  double t_enter = t_in;
   const double band = config_.top_seen_band;
   // The beam must go on well past the cell: one that runs out of range just
   // behind a wall's face plane (or skims the free front part of a face
   // cell) proves nothing, one that continues several cells at that height
   // without a return proves the wall is not there.
   const double length_cells = std::hypot(dn, de);
-  while (true) {
+  while (t_enter < t_out) {
     const double t_exit = std::min(t_r, t_c);
     if ((1.0 - t_exit) * length_cells < min_continuation) break;
     if (t_enter > 0 && raw.inside(row, col)) {

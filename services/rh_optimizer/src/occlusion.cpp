@@ -16,9 +16,14 @@ int64_t VisibilityRecord::key(double north, double east) const {
 
 void VisibilityRecord::add_beam(const Vec3& origin, const Vec3& end, bool hit,
                                 double vehicle_altitude) {
-  const Vec3 d = end - origin;
-  const double horizontal = std::hypot(d.x(), d.y());
-  if (!(horizontal > 0) || !std::isfinite(horizontal)) return;
+  Vec3 d = end - origin;
+  double horizontal = std::hypot(d.x(), d.y());
+  if (!(horizontal > 0) || !std::isfinite(horizontal) || !std::isfinite(d.z())) return;
+  if (horizontal > max_reach_) {
+    d *= max_reach_ / horizontal;
+    horizontal = max_reach_;
+    hit = false;
+  }
   // Stop a cell short of a hit: that cell holds the obstacle.
   const double reach = (hit ? horizontal - resolution_ : horizontal) / horizontal;
   if (!(reach > 0)) return;

@@ -327,6 +327,8 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   mission_ = m;
   supervisor_.start_mission(m.mission_id, waypoints_from(m), limits_from(m.limits));
   visibility_.clear();
+  // As far as the record is kept round the vehicle (on_scan).
+  visibility_.set_max_reach(2.0 * m.limits.sensor_range);
   shadows_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
                    m.mission_id, m.name, m.limits.clearance, config_.optimizer.clearance_margin,

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "ofn/rh_optimizer/occlusion.hpp"
 
@@ -72,6 +73,24 @@ TEST(VisibilityRecord, MarksWhatABeamCrossesNearFlightAltitudeOnly) {
   v.forget_beyond(Vec3(0, 0, 0), 10.0);
   EXPECT_TRUE(v.seen(5.5, 0.5));
   EXPECT_FALSE(v.seen(18.5, 0.5));
+}
+
+TEST(VisibilityRecord, ABeamCountsOnlyAsFarAsItsReach) {
+  // A scan point 3.4e38 m away once grew the record by gigabytes in one
+  // beam (found by the bus fuzz): a beam counts to max_reach, without a
+  // hit, however far it ends.
+  VisibilityRecord v(1.0, 3.0, 100.0);
+  v.add_beam(Vec3(0.5, 0.5, -30), Vec3(std::numeric_limits<float>::max(), 0.5, -30), true, 30.0);
+  EXPECT_TRUE(v.seen(99.5, 0.5));
+  EXPECT_FALSE(v.seen(101.5, 0.5));
+  EXPECT_LE(v.size(), 101u);
+  v.add_beam(Vec3(0.5, 0.5, -30), Vec3(1e300, -1e300, -30), false, 30.0);
+  EXPECT_LE(v.size(), 202u);
+  // A shorter beam is as before: its hit cell not marked.
+  VisibilityRecord near(1.0, 3.0, 100.0);
+  near.add_beam(Vec3(0.5, 0.5, -30), Vec3(20.5, 0.5, -30), true, 30.0);
+  EXPECT_TRUE(near.seen(18.5, 0.5));
+  EXPECT_FALSE(near.seen(20.5, 0.5));
 }
 
 /// Level beams at flight altitude (30 m) from the vehicle at (0, 0) to every

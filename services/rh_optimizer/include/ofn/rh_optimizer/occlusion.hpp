@@ -24,13 +24,18 @@ namespace ofn::rh {
 /// has crossed within `band` metres of the vehicle's altitude.
 class VisibilityRecord {
  public:
-  explicit VisibilityRecord(double resolution = 1.0, double band = 3.0)
-      : resolution_(resolution), band_(band) {}
+  /// `max_reach`: metres of a beam that count, horizontally from its
+  /// origin; a longer one (no LIDAR sees that far) counts to there as a
+  /// beam without a hit, so that the cells one beam adds stay bounded
+  /// (2 max_reach / resolution) whatever its end.
+  explicit VisibilityRecord(double resolution = 1.0, double band = 3.0, double max_reach = 400.0)
+      : resolution_(resolution), band_(band), max_reach_(max_reach) {}
 
   /// One beam from the sensor at `origin` to `end` (world NED); `hit`: the
   /// end cell holds the obstacle and is not marked. `vehicle_altitude` is
   /// the altitude (-z) the band is centred on.
   void add_beam(const Vec3& origin, const Vec3& end, bool hit, double vehicle_altitude);
+  void set_max_reach(double metres) { max_reach_ = metres; }
   bool seen(double north, double east) const { return cells_.count(key(north, east)) > 0; }
   size_t size() const { return cells_.size(); }
   void clear() { cells_.clear(); }
@@ -43,6 +48,7 @@ class VisibilityRecord {
 
   double resolution_;
   double band_;
+  double max_reach_;
   std::unordered_set<int64_t> cells_;
 };
 
