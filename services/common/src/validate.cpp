@@ -1,6 +1,7 @@
 #include "ofn/common/validate.hpp"
 
 #include <algorithm>
+#include <vector>
 
 #include "ofn/common/ref_traj_sample.hpp"
 
@@ -11,6 +12,14 @@ const char* kFrame = "NED";
 
 bool within_world(const double (&p)[3]) {
   return all_finite(p) && std::abs(p[0]) < MessageLimits::kMaxCoordinate &&
+         std::abs(p[1]) < MessageLimits::kMaxCoordinate &&
+         std::abs(p[2]) < MessageLimits::kMaxCoordinate;
+}
+
+// A point of a scan: three floats within the world.
+bool within_world(const std::vector<float>& p) {
+  return p.size() == 3 && all_finite(p.begin(), p.end()) &&
+         std::abs(p[0]) < MessageLimits::kMaxCoordinate &&
          std::abs(p[1]) < MessageLimits::kMaxCoordinate &&
          std::abs(p[2]) < MessageLimits::kMaxCoordinate;
 }
@@ -105,7 +114,8 @@ std::string validate(const lidar_scan_t& m) {
   if (m.beam_dt_us.size() != n || m.elevation.size() != n || m.layer_angle.size() != n ||
       m.status.size() != n)
     return "beam arrays differ in length";
-  if (!(m.max_range > 0) || !std::isfinite(m.max_range)) return "max range not positive";
+  if (!(m.max_range > 0) || !(m.max_range < MessageLimits::kMaxCoordinate))
+    return "max range not positive or beyond the world";
   if (!all_finite(m.elevation.begin(), m.elevation.end()) ||
       !all_finite(m.layer_angle.begin(), m.layer_angle.end()))
     return "beam angle not finite";
@@ -133,13 +143,13 @@ std::string validate(const scan_world_t& m) {
     return e;
   if (!within_world(m.sensor_origin)) return "sensor origin not finite";
   for (const auto& p : m.points)
-    if (!all_finite(p.begin(), p.end()) || p.size() != 3) return "point not finite";
+    if (!within_world(p)) return "point not finite or out of range";
   if (auto e = check_count(m.num_free_rays, m.free_ray_ends.size(), MessageLimits::kMaxScanPoints,
                            "free rays");
       !e.empty())
     return e;
   for (const auto& p : m.free_ray_ends)
-    if (!all_finite(p.begin(), p.end()) || p.size() != 3) return "free ray end not finite";
+    if (!within_world(p)) return "free ray end not finite or out of range";
   if (m.num_rejected < 0) return "negative rejected count";
   return "";
 }

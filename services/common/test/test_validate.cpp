@@ -511,6 +511,22 @@ TEST(Validate, OtherTypesRejectTheirBadCases) {
   EXPECT_NE(validate(h), "");
 }
 
+// A scan point or a LIDAR range the size of FLT_MAX is finite, and sent
+// the mapper and the RH optimiser walking beams 3.4e38 m long (the bus
+// fuzz): scans lie within the world as every other position does.
+TEST(Validate, ScansLieWithinTheWorld) {
+  scan_world_t w = good_scan_world();
+  w.points[0][0] = 2.0e6f;
+  EXPECT_EQ(validate(w), "point not finite or out of range");
+  w = good_scan_world();
+  w.free_ray_ends.push_back({0.0f, std::numeric_limits<float>::max(), 0.0f});
+  w.num_free_rays = static_cast<int32_t>(w.free_ray_ends.size());
+  EXPECT_EQ(validate(w), "free ray end not finite or out of range");
+  lidar_scan_t l = good_scan();
+  l.max_range = 1.0e300;
+  EXPECT_EQ(validate(l), "max range not positive or beyond the world");
+}
+
 // Every float of every type is checked: the bus fuzz found these fields
 // passed with NaN or Inf in them (tests/fuzz).
 TEST(Validate, NonFiniteNumbersOutsideTheGeometryAreRejectedToo) {
