@@ -1,77 +1,105 @@
-// Publishes garbage on every channel of the bus (random bytes, each message
-// type filled with NaN or with absurd sizes, and valid encodings with a
-// hostile int32 written over a random field: negative or huge array counts
-// and string lengths behind a valid fingerprint), then listens to the
-// heartbeats and reports each service's rejection counter. Alongside the
-// garbage it sends well-formed forgeries stamped with the simulation's own
-// time, each of which a service must refuse: a SIM_CLOCK 1,000 s ahead, a
-// CONTROL_STATUS saying DONE mid-flight, a REF_TRAJ at five times the speed
-// limit and an ACTUATOR_CMD beyond the cyclic's range. (A forged MISSION
-// that the controller refuses would still be taken by the planners: only an
-// authenticated bus can stop that.) Exits 0 when every service named on the
-// command line is still alive and has rejected something.
+// ofn_bus_fuzz: puts the bus fuzz's messages (tests/fuzz: every channel of
+// the channel table, every field of a valid message of its type made wrong
+// in turn: cut short, behind a wrong fingerprint, a size or string length
+// up to 2^31, NaN and Inf in every float, a stamp far in the past or the
+// future, random bytes, oversized) on a live bus at a steady rate, and
+// checks with the services' heartbeats that each one named on the command
+// line lived through it (the same pid before and after) and counted what it
+// refused.
+//
+// Before the flood it listens for every service's heartbeat and takes the
+// flight's own messages as the seeds of their channels (a channel nobody
+// publishes keeps a built-in seed); during it, stamps follow SIM_CLOCK (the
+// wall clock on a bus without one). Every `--forgery-every` messages it
+// also sends well-formed forgeries stamped with the simulation's own time,
+// which a service must refuse: a SIM_CLOCK 1,000 s ahead, a CONTROL_STATUS
+// saying DONE mid-flight, a REF_TRAJ at five times the speed limit and an
+// ACTUATOR_CMD beyond the cyclic's range. (A forged MISSION that the
+// controller refuses would still be taken by the planners: only an
+// authenticated bus can stop that.)
+//
+// Exit code 0 when every expected service is alive with its pid and has
+// refused more than before; 1 when one is not; 2 for bad input.
+
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <iostream>
-#include <limits>
 #include <map>
 #include <memory>
-#include <random>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
 
 #include "ofn/actuator_cmd_t.hpp"
 #include "ofn/bus_auth/authenticator.hpp"
+#include "ofn/common/channel_table.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
 #include "ofn/common/command_line.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/control_status_t.hpp"
+#include "ofn/fuzz/fuzz_cases.hpp"
 #include "ofn/heartbeat_t.hpp"
-#include "ofn/mission_t.hpp"
-#include "ofn/nav_state_t.hpp"
 #include "ofn/ref_traj_t.hpp"
 #include "ofn/sim_clock_t.hpp"
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using Clock = std::chrono::steady_clock;
+constexpr ofn::Utime kSecond = 1000000;
 
-/// `m` encoded, with a hostile int32 (big-endian) written at a random
-/// 4-byte-aligned offset after the fingerprint: wherever it lands on an
-/// array count or a string length, the decoder must fail cleanly.
-template <class Msg>
-std::vector<uint8_t> with_hostile_int32(const Msg& m, std::mt19937& rng) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  static const int32_t kHostile[] = {-1, -2147483647 - 1, 0, 1 << 26, 2147483647};
-  if (bytes.size() < 12) return bytes;
-  const size_t slots = (bytes.size() - 8) / 4;
-  const size_t at = 8 + 4 * std::uniform_int_distribution<size_t>(0, slots - 1)(rng);
-  const auto value = static_cast<uint32_t>(kHostile[std::uniform_int_distribution<int>(0, 4)(rng)]);
-  for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<uint8_t>(value >> (24 - 8 * i));
-  return bytes;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-/// The simulation time from SIM_CLOCK, ignoring this program's own forged
-/// stamps (multicast loops them back).
-void on_sim_clock(const lcm::ReceiveBuffer* rbuf, const std::string&, ofn::Utime* sim_now) {
-  ofn::sim_clock_t m;
-  if (!ofn::bus_auth::decode_payload(m, rbuf->data, rbuf->data_size)) return;
-  if (*sim_now == INT64_MIN || (m.utime >= *sim_now && m.utime - *sim_now < 100 * 1000000LL))
-    *sim_now = m.utime;
-}
+/// What the listening handle hears: the services' heartbeats, the
+/// simulation's time, and (before the flood) the flight's own messages.
+struct Listener {
+  std::map<std::string, ofn::heartbeat_t> heartbeats;  // by service
+  ofn::Utime sim_now = INT64_MIN;
+  ofn::fuzz::Fuzzer* harvest = nullptr;  // set while seeds are taken
+  std::map<std::string, Clock::time_point> offered;
+  std::map<std::string, int> seeds_taken;  // by channel
+  ofn::WallClock wall;
+  int32_t own_pid = static_cast<int32_t>(::getpid());
 
-void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string&,
-                  std::map<std::string, ofn::heartbeat_t>* seen) {
-  ofn::heartbeat_t hb;
-  if (ofn::bus_auth::decode_payload(hb, rbuf->data, rbuf->data_size)) (*seen)[hb.service] = hb;
-}
+  ofn::Utime now() const { return sim_now != INT64_MIN ? sim_now : wall.now(); }
+
+  void on_heartbeat(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    ofn::heartbeat_t hb;
+    if (!ofn::bus_auth::decode_payload(hb, rbuf->data, rbuf->data_size)) return;
+    if (hb.pid == own_pid) return;  // this program's own fuzz
+    heartbeats[hb.service] = hb;
+  }
+
+  void on_sim_clock(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    // The simulation's stamps move forward a little at a time; this
+    // program's own (multicast loops them back) jump.
+    ofn::sim_clock_t m;
+    if (!ofn::bus_auth::decode_payload(m, rbuf->data, rbuf->data_size) || m.utime <= 0) return;
+    if (sim_now == INT64_MIN || (m.utime >= sim_now && m.utime - sim_now < 10 * kSecond))
+      sim_now = m.utime;
+  }
+
+  void on_any(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    if (harvest == nullptr) return;
+    const auto last = offered.find(channel);
+    if (last != offered.end() && Clock::now() - last->second < std::chrono::seconds(1)) return;
+    offered[channel] = Clock::now();
+    if (harvest->offer_seed(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size,
+                            now(), 5 * kSecond, 4096))
+      ++seeds_taken[channel];
+  }
+};
 
 /// Signs the forgeries when set (--sign-as): a stranger who holds one
 /// host's key and signs what that host may not publish.
@@ -90,10 +118,11 @@ void publish_forgery(lcm::LCM& lcm, const std::string& channel, const Msg& msg) 
 }
 
 /// Well-formed messages that pass validation and must still be refused.
-void publish_forgeries(lcm::LCM& lcm, ofn::Utime now) {
+/// Returns how many were sent.
+int publish_forgeries(lcm::LCM& lcm, ofn::Utime now) {
   namespace ch = ofn::channels;
   ofn::sim_clock_t clock{};
-  clock.utime = now + 1000 * 1000000LL;
+  clock.utime = now + 1000 * kSecond;
   clock.real_time_factor = 1.0;
   publish_forgery(lcm, ch::kSimClock, clock);
 
@@ -120,20 +149,57 @@ void publish_forgeries(lcm::LCM& lcm, ofn::Utime now) {
   cmd.collective = 0.1;
   cmd.lon_cyclic = 0.9;
   publish_forgery(lcm, ch::kActuatorCmd, cmd);
+  return 4;
+}
+
+/// Handles what has arrived, at most `limit` messages.
+void drain(lcm::LCM& lcm, int limit = 20000) {
+  for (int i = 0; i < limit && lcm.handleTimeout(0) > 0; ++i) {
+  }
+}
+
+std::string upper(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   ofn::CommandLine app{"ofn_bus_fuzz",
-                       "publish garbage on every channel and check that services reject it"};
+                       "publish the bus fuzz's messages on every channel and check that the "
+                       "services live through them and count them"};
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
   std::vector<std::string> services;
-  int rounds = 200;
+  int64_t messages = 5000;
+  double rate = 2000.0;
+  double wait = 30.0;
+  double listen = 3.0;
+  int forgery_every = 100;
+  uint64_t seed = 42;
+  std::string report_path;
+  bool builtin_seeds = false;
   app.add_option("--lcm-url", url, "LCM URL of the bus to attack");
-  app.add_option("--rounds", rounds, "garbage messages per channel and kind");
+  app.add_option("--messages", messages, "fuzz messages to send")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 40));
+  app.add_option("--rate", rate, "messages per second")->check(CLI::Range(1.0, 1.0e6));
   app.add_option("--expect", services, "services that must stay alive and count rejections")
       ->required();
+  app.add_option("--wait", wait,
+                 "seconds to wait for every expected service's heartbeat before the flood")
+      ->check(CLI::Range(0.0, 3600.0));
+  app.add_option("--listen", listen,
+                 "seconds to listen for the flight's own messages (the seeds) before the flood")
+      ->check(CLI::Range(0.0, 3600.0));
+  app.add_option("--forgery-every", forgery_every,
+                 "send the four well-formed forgeries after every N fuzz messages; 0 = never")
+      ->check(CLI::Range(0, 1 << 30));
+  app.add_option("--seed", seed, "seed of the random parts (the same seed, the same messages)");
+  app.add_flag("--builtin-seeds", builtin_seeds,
+               "mutate the built-in seed of every channel, not the flight's own messages");
+  app.add_option("--report", report_path,
+                 "write what was sent and what each service counted to this JSON file "
+                 "(default: none)");
   std::string sign_as, bus_keys;
   app.add_option("--sign-as", sign_as,
                  "sign the well-formed forgeries with this role's key from --bus-keys, as "
@@ -141,99 +207,182 @@ int main(int argc, char** argv) {
   app.add_option("--bus-keys", bus_keys,
                  "keyring holding the --sign-as role's key (default: none)");
   if (const auto code = ofn::parse_command_line(app, argc, argv)) return *code;
-  if (!sign_as.empty()) {
-    // The stranger's own signer lets it sign anything; receivers judge.
-    const std::string dir = bus_keys + "/";
-    auto policy = ofn::bus_auth::PublishPolicy::load(dir + "policy.yaml");
-    policy.allow(sign_as, "*");
-    std::map<std::string, ofn::bus_auth::PublicKey> keys;
-    for (const auto& role : policy.roles())
-      keys[role] = ofn::bus_auth::read_public_key(dir + role + ".pub");
-    // The clock goes with the signer (by value): this block ends before it
-    // signs anything.
-    const ofn::WallClock wall;
-    g_forger = std::make_unique<ofn::bus_auth::Authenticator>(
-        sign_as, ofn::bus_auth::read_secret_key(dir + sign_as + ".key"), keys, policy,
-        [wall] { return wall.now(); });
+
+  try {
+    if (!sign_as.empty()) {
+      // The stranger's own signer lets it sign anything; receivers judge.
+      const std::string dir = bus_keys + "/";
+      auto policy = ofn::bus_auth::PublishPolicy::load(dir + "policy.yaml");
+      policy.allow(sign_as, "*");
+      std::map<std::string, ofn::bus_auth::PublicKey> keys;
+      for (const auto& role : policy.roles())
+        keys[role] = ofn::bus_auth::read_public_key(dir + role + ".pub");
+      // The clock goes with the signer (by value): this block ends before
+      // it signs anything.
+      const ofn::WallClock wall;
+      g_forger = std::make_unique<ofn::bus_auth::Authenticator>(
+          sign_as, ofn::bus_auth::read_secret_key(dir + sign_as + ".key"), keys, policy,
+          [wall] { return wall.now(); });
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "ofn_bus_fuzz: " << e.what() << "\n";
+    return 2;
   }
 
-  lcm::LCM lcm(url);
-  if (!lcm.good()) return 2;
-  std::map<std::string, ofn::heartbeat_t> seen;
-  lcm.subscribeFunction("HEARTBEAT_.*", &on_heartbeat, &seen);
-  ofn::Utime sim_now = INT64_MIN;
-  lcm.subscribeFunction(ofn::channels::kSimClock, &on_sim_clock, &sim_now);
-
-  namespace ch = ofn::channels;
-  const std::vector<std::string> channels = {ch::kNavState,    ch::kActuatorCmd,      ch::kSimClock,
-                                             ch::kMission,     ch::kVirtualObstacles, ch::kLidarRaw,
-                                             ch::kScanWorld,   ch::kObstacleGrid,     ch::kCuboids,
-                                             ch::kGlobalPath,  ch::kNarrowPassages,   ch::kRefTraj,
-                                             ch::kSolverStats, ch::kControlStatus};
-  std::mt19937 rng(42);
-  std::uniform_int_distribution<int> byte(0, 255), length(0, 600);
-
-  ofn::nav_state_t nav{};
-  nav.frame = "NED";
-  for (int i = 0; i < 3; ++i) nav.position[i] = kNaN;
-  nav.quaternion[0] = 1;
-  ofn::actuator_cmd_t cmd{};
-  cmd.collective = kNaN;
-  ofn::sim_clock_t clock{};
-  clock.real_time_factor = kNaN;
-  ofn::mission_t mission{};
-  mission.frame = "NED";
-  mission.cruise_speed = kNaN;
-  ofn::ref_traj_t traj{};
-  traj.frame = "NED";
-  traj.num_samples = 2;
-  traj.sample_time = {0.0, kNaN};
-  traj.position = traj.velocity = traj.acceleration = {{0, 0, 0}, {0, 0, 0}};
-  ofn::control_status_t status{};
-  status.ref_position[0] = kNaN;
-
-  for (int r = 0; r < rounds; ++r) {
-    for (const auto& c : channels) {
-      std::vector<uint8_t> junk(static_cast<size_t>(length(rng)));
-      for (auto& b : junk) b = static_cast<uint8_t>(byte(rng));
-      lcm.publish(c, junk.data(), static_cast<unsigned>(junk.size()));
-    }
-    lcm.publish(ch::kNavState, &nav);
-    lcm.publish(ch::kActuatorCmd, &cmd);
-    lcm.publish(ch::kSimClock, &clock);
-    lcm.publish(ch::kMission, &mission);
-    lcm.publish(ch::kRefTraj, &traj);
-    lcm.publish(ch::kControlStatus, &status);
-    const auto hostile = [&](const std::string& channel, const auto& m) {
-      const std::vector<uint8_t> bytes = with_hostile_int32(m, rng);
-      lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
-    };
-    hostile(ch::kNavState, nav);
-    hostile(ch::kMission, mission);
-    hostile(ch::kRefTraj, traj);
-    hostile(ch::kControlStatus, status);
-    if (sim_now != INT64_MIN) publish_forgeries(lcm, sim_now);
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    while (lcm.handleTimeout(0) > 0) {
-    }
+  // Every channel of the table; the heartbeat family on the expected
+  // services' own channels and one of its own.
+  std::map<std::string, std::vector<std::string>> families;
+  for (const auto& entry : ofn::channel_table()) {
+    if (!entry.prefix) continue;
+    auto& names = families[entry.name];
+    for (const auto& s : services) names.push_back(entry.name + upper(s));
+    names.push_back(std::string(entry.name) + "FUZZ");
   }
-  // Heartbeats come once a second of (simulated) time; listen long enough.
-  seen.clear();
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(4);
-  while (std::chrono::steady_clock::now() < until) lcm.handleTimeout(100);
+  std::optional<ofn::fuzz::Fuzzer> fuzzer;
+  try {
+    static const ofn::fuzz::Schema schema =
+        ofn::fuzz::Schema::parse(ofn::fuzz::builtin_lcm_sources());
+    fuzzer.emplace(schema, ofn::channel_table(), ofn::fuzz::message_supports(), families, seed);
+  } catch (const std::exception& e) {
+    // A channel without a generator: the fuzz would leave it out.
+    std::cerr << "ofn_bus_fuzz: " << e.what() << "\n";
+    return 2;
+  }
+
+  lcm::LCM ear(url), mouth(url);
+  if (!ear.good() || !mouth.good()) {
+    std::cerr << "ofn_bus_fuzz: cannot open LCM at '" << url << "'\n";
+    return 2;
+  }
+  Listener listener;
+  ear.subscribe("HEARTBEAT_.*", &Listener::on_heartbeat, &listener);
+  ear.subscribe(ofn::channels::kSimClock, &Listener::on_sim_clock, &listener);
+  lcm::Subscription* everything = nullptr;
+  if (!builtin_seeds) {
+    listener.harvest = &*fuzzer;
+    everything = ear.subscribe(".*", &Listener::on_any, &listener);
+  }
+
+  // Every expected service heard, then the flight's own messages for a
+  // while: the pids and counters the flood is judged against.
+  const auto wait_start = Clock::now();
+  std::cout << "fuzz: waiting for the heartbeats of " << services.size() << " services"
+            << std::endl;
+  auto all_heard = [&] {
+    for (const auto& s : services)
+      if (!listener.heartbeats.count(s)) return false;
+    return true;
+  };
+  while (!all_heard() && seconds_since(wait_start) < wait) ear.handleTimeout(100);
+  const auto listen_start = Clock::now();
+  while (seconds_since(listen_start) < listen) ear.handleTimeout(100);
+  for (const auto& s : services)
+    if (!listener.heartbeats.count(s)) {
+      std::cout << "fuzz: " << s << ": no heartbeat in " << wait << " s; not started?" << std::endl;
+      return 1;
+    }
+  listener.harvest = nullptr;
+  if (everything) ear.unsubscribe(everything);
+  const auto before = listener.heartbeats;
+  std::string taken;
+  for (const auto& [channel, n] : listener.seeds_taken) taken += " " + channel;
+  std::cout << "fuzz: seeds from the flight on" << (taken.empty() ? " no channel" : taken)
+            << "; built-in seeds on the others" << std::endl;
+
+  // The flood, paced: message i goes at start + i / rate.
+  std::map<std::string, int64_t> by_kind, by_channel;
+  int64_t sent = 0, forgeries = 0, bytes_sent = 0;
+  const auto start = Clock::now();
+  std::cout << "fuzz: flooding " << messages << " messages at " << rate << "/s on "
+            << fuzzer->channels().size() << " channels" << std::endl;
+  auto next_progress = start + std::chrono::seconds(10);
+  while (sent < messages) {
+    const auto due = std::min<int64_t>(
+        messages, static_cast<int64_t>(std::floor(seconds_since(start) * rate)) + 1);
+    while (sent < due) {
+      const ofn::fuzz::FuzzMessage m = fuzzer->next(listener.now());
+      mouth.publish(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
+      ++by_kind[ofn::fuzz::kind_name(m.kind)];
+      ++by_channel[m.channel];
+      bytes_sent += static_cast<int64_t>(m.bytes.size());
+      ++sent;
+      if (forgery_every > 0 && sent % forgery_every == 0 && listener.sim_now != INT64_MIN)
+        forgeries += publish_forgeries(mouth, listener.sim_now);
+    }
+    drain(ear);
+    if (Clock::now() >= next_progress) {
+      std::cout << "fuzz: sent " << sent << " of " << messages << " ("
+                << std::lround(sent / seconds_since(start)) << "/s)" << std::endl;
+      next_progress += std::chrono::seconds(10);
+    }
+    const auto next_due = start + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>((sent + 1) / rate));
+    if (next_due > Clock::now())
+      std::this_thread::sleep_until(
+          std::min(next_due, Clock::now() + std::chrono::milliseconds(5)));
+  }
+  const double took = seconds_since(start);
+  std::cout << "fuzz: flood done: " << sent << " messages (" << bytes_sent / 1000000.0
+            << " MB) and " << forgeries << " forgeries in " << took << " s" << std::endl;
+
+  // Heartbeats come once a second of (simulated) time; listen long enough
+  // for every service's next two.
+  listener.heartbeats.clear();
+  const auto after_start = Clock::now();
+  while (seconds_since(after_start) < 4.0) ear.handleTimeout(100);
 
   int failures = 0;
+  nlohmann::json report;
+  report["messages"] = sent;
+  report["forgeries"] = forgeries;
+  report["bytes"] = bytes_sent;
+  report["seconds"] = took;
+  report["rate"] = sent / took;
+  report["by_kind"] = by_kind;
+  report["by_channel"] = by_channel;
+  report["seeds_from_flight"] = nlohmann::json::array();
+  for (const auto& [channel, n] : listener.seeds_taken)
+    report["seeds_from_flight"].push_back(channel);
   for (const auto& name : services) {
-    auto it = seen.find(name);
-    if (it == seen.end()) {
-      std::cout << "fuzz: " << name << ": no heartbeat after the flood (dead?)\n";
-      ++failures;
-    } else if (it->second.rejected <= 0) {
-      std::cout << "fuzz: " << name << ": alive but rejected nothing\n";
+    const auto& b = before.at(name);
+    nlohmann::json entry;
+    entry["pid_before"] = b.pid;
+    entry["rejected_before"] = b.rejected;
+    entry["received_before"] = b.received;
+    const auto it = listener.heartbeats.find(name);
+    if (it == listener.heartbeats.end()) {
+      std::cout << "fuzz: " << name << ": no heartbeat after the flood (dead?)" << std::endl;
+      entry["alive"] = false;
       ++failures;
     } else {
-      std::cout << "fuzz: " << name << ": alive, rejected " << it->second.rejected
-                << " (last: " << it->second.last_reject_reason << ")\n";
+      const auto& a = it->second;
+      entry["alive"] = true;
+      entry["pid_after"] = a.pid;
+      entry["rejected_after"] = a.rejected;
+      entry["received_after"] = a.received;
+      entry["last_reject_reason"] = a.last_reject_reason;
+      if (a.pid != b.pid) {
+        std::cout << "fuzz: " << name << ": restarted during the flood (pid " << b.pid << " -> "
+                  << a.pid << ")" << std::endl;
+        ++failures;
+      } else if (a.rejected <= b.rejected) {
+        std::cout << "fuzz: " << name << ": alive but rejected nothing" << std::endl;
+        ++failures;
+      } else {
+        std::cout << "fuzz: " << name << ": alive (pid " << a.pid << "), rejected "
+                  << a.rejected - b.rejected << " (last: " << a.last_reject_reason << ")"
+                  << std::endl;
+      }
+    }
+    report["services"][name] = entry;
+  }
+  report["failures"] = failures;
+  if (!report_path.empty()) {
+    std::ofstream out(report_path);
+    out << report.dump(2) << "\n";
+    if (!out) {
+      std::cerr << "ofn_bus_fuzz: cannot write " << report_path << "\n";
+      return 2;
     }
   }
   return failures == 0 ? 0 : 1;

@@ -31,7 +31,7 @@ tag=$(sed -n 's/^fly3: three hosts: network namespaces \([^{]*\)-{.*/\1/p' "$WOR
 fuzz_status=0
 if [[ -n $tag ]] && kill -0 $fly 2> /dev/null; then
   ip netns exec "$tag-gcs" "$BIN/ofn_bus_fuzz" --lcm-url 'udpm://239.255.76.67:7667?ttl=1' \
-    --rounds 50 --sign-as gcs --bus-keys "$WORK/run/keyring/gcs" \
+    --messages 1500 --forgery-every 30 --sign-as gcs --bus-keys "$WORK/run/keyring/gcs" \
     --expect controller --expect vehicle_sim --expect rh_optimizer --expect mapper \
     > "$WORK/fuzz.txt" 2>&1 || fuzz_status=$?
 fi
