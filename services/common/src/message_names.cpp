@@ -1,5 +1,7 @@
 #include "ofn/common/message_names.hpp"
 
+#include <cstdio>
+
 #include "ofn/control_status_t.hpp"
 #include "ofn/global_path_t.hpp"
 #include "ofn/ref_traj_t.hpp"
@@ -81,6 +83,22 @@ const char* path_status_name(int status) {
     default:
       return "UNKNOWN";
   }
+}
+
+std::string printable(const std::string& text, size_t max_chars) {
+  std::string out;
+  for (size_t i = 0; i < text.size() && i < max_chars; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c <= 0x7e && c != '\\') {
+      out += static_cast<char>(c);
+    } else {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+      out += escaped;
+    }
+  }
+  if (text.size() > max_chars) out += "...";
+  return out;
 }
 
 }  // namespace ofn

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
 
 namespace ofn {
@@ -34,7 +35,7 @@ std::string check_count(int32_t count, size_t actual, int32_t max, const char* w
 }
 
 std::string check_frame(const std::string& frame) {
-  return frame == kFrame ? "" : "frame '" + frame + "' is not NED";
+  return frame == kFrame ? "" : "frame '" + printable(frame, 16) + "' is not NED";
 }
 
 }  // namespace

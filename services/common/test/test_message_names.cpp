@@ -45,5 +45,12 @@ TEST(MessageNames, EveryValueHasItsOwnName) {
                                            global_path_t::NO_PATH, global_path_t::BACKTRACK});
 }
 
+TEST(MessageNames, TextFromTheBusIsOnePrintableLine) {
+  EXPECT_EQ(printable("open"), "open");
+  EXPECT_EQ(printable(std::string("N\x8d\nD\0", 5)), "N\\x8d\\x0aD\\x00");
+  EXPECT_EQ(printable("a\\b"), "a\\x5cb");  // a backslash cannot fake an escape
+  EXPECT_EQ(printable(std::string(100, 'x'), 8), "xxxxxxxx...");
+}
+
 }  // namespace
 }  // namespace ofn

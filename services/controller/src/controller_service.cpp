@@ -314,8 +314,8 @@ void ControllerService::on_mission(const mission_t& m) {
   // A new plan starts under guidance; the optimiser restarts with it.
   ref_traj_.reset();
   selector_.hand_back();
-  node_.log().info("mission {} '{}': {} waypoints, cruise {:.2f} m/s", m.mission_id, m.name,
-                   m.num_waypoints, m.cruise_speed);
+  node_.log().info("mission {} '{}': {} waypoints, cruise {:.2f} m/s", m.mission_id,
+                   printable(m.name), m.num_waypoints, m.cruise_speed);
 }
 
 void ControllerService::on_ref_traj(ref_traj_t m) {

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "ofn/common/channels.hpp"
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/validate/control_status.hpp"
 #include "ofn/common/validate/cuboid_list.hpp"
 #include "ofn/common/validate/mission.hpp"
@@ -172,8 +173,8 @@ void GlobalPlannerService::on_mission(const mission_t& m) {
   active_leg_ = -1;
   no_go_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m, accel {:.3f} m/s^2, speed {:.2f} m/s",
-                   m.mission_id, m.name, planner_->config().clearance, planner_->config().max_accel,
-                   planner_->config().speed);
+                   m.mission_id, printable(m.name), planner_->config().clearance,
+                   planner_->config().max_accel, planner_->config().speed);
   replan("new mission");
 }
 

@@ -6,6 +6,7 @@
 
 #include "ofn/common/channels.hpp"
 #include "ofn/common/message_checks.hpp"
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/mission_plan.hpp"
 #include "ofn/common/ref_traj_sample.hpp"
 #include "ofn/common/validate/control_status.hpp"
@@ -331,8 +332,8 @@ void RhOptimizerService::on_mission(const mission_t& m) {
   visibility_.set_max_reach(2.0 * m.limits.sensor_range);
   shadows_.clear();
   node_.log().info("mission {} '{}': clearance {:.2f} m (+{:.2f} m planned), accel {:.3f} m/s^2",
-                   m.mission_id, m.name, m.limits.clearance, config_.optimizer.clearance_margin,
-                   m.limits.max_accel);
+                   m.mission_id, printable(m.name), m.limits.clearance,
+                   config_.optimizer.clearance_margin, m.limits.max_accel);
 }
 
 void RhOptimizerService::on_grid(const obstacle_grid_t& m) {

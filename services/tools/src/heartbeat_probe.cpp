@@ -6,6 +6,7 @@
 #include "ofn/bus_auth/trailer.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/message_caps.hpp"
+#include "ofn/common/message_names.hpp"
 #include "ofn/common/validate/heartbeat.hpp"
 #include "ofn/heartbeat_t.hpp"
 
@@ -16,7 +17,7 @@ HeartbeatProbe::HeartbeatProbe(std::optional<bus_auth::Verifier> verifier)
 
 std::string HeartbeatProbe::refuse(const std::string& channel, const std::string& reason) {
   ++refused_;
-  last_reason_ = channel + ": " + reason;
+  last_reason_ = printable(channel) + ": " + reason;
   return "";
 }
 
