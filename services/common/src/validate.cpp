@@ -163,8 +163,14 @@ std::string validate(const obstacle_grid_t& m) {
           check_count(m.num_cells, m.top_altitude.size(), MessageLimits::kMaxGridCells, "cells");
       !e.empty())
     return e;
-  if (!(m.resolution > 0) || !std::isfinite(m.resolution)) return "resolution not positive";
+  if (!(m.resolution >= MessageLimits::kMinGridResolution &&
+        m.resolution <= MessageLimits::kMaxGridResolution))
+    return "resolution outside 0.05..20 m";
   if (!all_finite(m.origin) || !std::isfinite(m.safety_margin)) return "grid geometry not finite";
+  if (std::abs(m.origin[0]) >= MessageLimits::kMaxCoordinate ||
+      std::abs(m.origin[1]) >= MessageLimits::kMaxCoordinate ||
+      !(m.safety_margin >= 0 && m.safety_margin < MessageLimits::kMaxCoordinate))
+    return "grid origin or margin out of range";
   if (!all_finite(m.top_altitude.begin(), m.top_altitude.end())) return "cell not finite";
   return "";
 }

@@ -527,6 +527,29 @@ TEST(Validate, ScansLieWithinTheWorld) {
   EXPECT_EQ(validate(l), "max range not positive or beyond the world");
 }
 
+// The RH optimiser pads a grid by its distance field's reach in cells: a
+// cell of denorm_min metres made that pad the int of infinity (the bus
+// fuzz). The resolution is the mapper's own range, the origin within the
+// world.
+TEST(Validate, ObstacleGridGeometryIsTheMappers) {
+  for (double resolution : {0.05, 1.0, 20.0}) {
+    obstacle_grid_t g = good_grid();
+    g.resolution = resolution;
+    EXPECT_EQ(validate(g), "") << resolution;
+  }
+  for (double resolution : {std::numeric_limits<double>::denorm_min(), 0.01, 21.0, 1e300}) {
+    obstacle_grid_t g = good_grid();
+    g.resolution = resolution;
+    EXPECT_EQ(validate(g), "resolution outside 0.05..20 m") << resolution;
+  }
+  obstacle_grid_t g = good_grid();
+  g.origin[1] = 2.0e6;
+  EXPECT_EQ(validate(g), "grid origin or margin out of range");
+  g = good_grid();
+  g.safety_margin = -1.0;
+  EXPECT_EQ(validate(g), "grid origin or margin out of range");
+}
+
 // Every float of every type is checked: the bus fuzz found these fields
 // passed with NaN or Inf in them (tests/fuzz).
 TEST(Validate, NonFiniteNumbersOutsideTheGeometryAreRejectedToo) {

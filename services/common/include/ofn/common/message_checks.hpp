@@ -26,6 +26,12 @@ struct MessageLimits {
   static constexpr int kMaxPassages = 1000;
   /// Positions farther than this from the origin are not from this mission.
   static constexpr double kMaxCoordinate = 1.0e6;
+  /// An obstacle grid's cell edge, m: the mapper's own range (its grid
+  /// resolution setting). Receivers size fields from it (the RH
+  /// optimiser pads the grid by tens of metres of cells), so a cell of
+  /// 1e-300 m or 1e300 m must not reach them.
+  static constexpr double kMinGridResolution = 0.05;
+  static constexpr double kMaxGridResolution = 20.0;
 };
 
 template <class It>
