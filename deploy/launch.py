@@ -833,7 +833,9 @@ class HangWatch:
                  heartbeats of others heard since its last show the
                  simulation ran `timeout` s of its time on without it.
     Nobody is judged while the probe itself is not heard (its "tick" once a
-    second): a deaf watchdog must not kill what it cannot hear."""
+    second): a deaf watchdog must not kill what it cannot hear. Heartbeats
+    of processes it did not start (a stranger's, a replayed log's) are no
+    evidence either way."""
 
     class Entry:
         def __init__(self, kind, group, now):
@@ -871,14 +873,18 @@ class HangWatch:
 
     def heard(self, channel, pid, stamp, now):
         """A heartbeat the probe heard on `channel` from process `pid`,
-        stamped `stamp` (s)."""
+        stamped `stamp` (s). Only a watched process's own heartbeats count,
+        as its sign of life and as the simulation's progress: on an open
+        bus anyone may send one, and a stranger's stamp 2^63 us ahead made
+        every silent follower look hung at once (the bus fuzz)."""
         with self.lock:
             self.probe_at = now
-            self.latest[channel] = (now, stamp)
             entry = self.entries.get(channel)
-            if entry is not None and (pid == entry.group or self.group_of(pid) == entry.group):
-                entry.last_at = now
-                entry.ref_stamp = stamp
+            if entry is None or not (pid == entry.group or self.group_of(pid) == entry.group):
+                return
+            self.latest[channel] = (now, stamp)
+            entry.last_at = now
+            entry.ref_stamp = stamp
             # A process not heard yet measures the simulation from the first
             # stamp of another heard since its start.
             for other_channel, other in self.entries.items():

@@ -817,6 +817,31 @@ class HangWatchTest(unittest.TestCase):
         self.assertIsNone(watch.verdict("mapper", 33.9))
         self.assertIsNotNone(watch.verdict("mapper", 34.0))
 
+    def test_a_strangers_heartbeats_neither_condemn_nor_save(self):
+        # A stranger's heartbeats, stamped 2^63 us ahead, on a service's
+        # channel and on one of its own: no evidence that the simulation ran
+        # on (the mapper, silent with the simulation, is not hung) and no
+        # sign of life (the controller, silent while vehicle_sim runs on, is).
+        watch = self.watch(groups={999: 999})
+        watch.started("vehicle_sim", "own", 100, 0.0)
+        watch.started("mapper", "sim_clock", 200, 0.0)
+        watch.started("controller", "sim_clock", 300, 0.0)
+        self.beat(watch, "mapper", 200, 1.0, 1.0)
+        self.beat(watch, "controller", 300, 1.0, 1.0)
+        self.beat(watch, "vehicle_sim", 100, 1.0, 1.0)
+        for t in range(2, 20):
+            for name in ("mapper", "controller", "fuzz"):
+                self.beat(watch, name, 999, 9.2e12, float(t))
+        self.assertIsNone(watch.verdict("mapper", 19.0))
+        self.assertIsNone(watch.verdict("controller", 19.0))
+        self.assertIsNotNone(watch.verdict("vehicle_sim", 19.0))  # its own clock: silence is enough
+        for t in range(20, 30):
+            self.beat(watch, "vehicle_sim", 100, float(t - 18), float(t))
+            self.beat(watch, "controller", 999, 9.2e12, float(t))
+        self.assertEqual(watch.verdict("controller", 29.0),
+                         "no heartbeat on HEARTBEAT_CONTROLLER for 28.0 s while the simulation "
+                         "ran 10.0 s on")
+
     def test_a_process_never_heard_gets_the_start_allowance(self):
         watch = self.watch()
         watch.started("mapper", "own", 200, 0.0)
