@@ -138,8 +138,14 @@ int main(int argc, char** argv) {
     for (const std::string& service : watched)
       node.subscribe<ofn::heartbeat_t>(
           ofn::heartbeat_channel(service),
-          [&heartbeats, &loss, &wall_seconds, service](const ofn::heartbeat_t& m) {
-            if (heartbeats) heartbeats->heard(service, wall_seconds());
+          [&heartbeats, &loss, &wall_seconds, &node, service](const ofn::heartbeat_t& m) {
+            // A heartbeat naming another service is no sign of life of this one,
+            // and its counts are not this service's.
+            if (m.service != service) {
+              node.reject(ofn::heartbeat_channel(service), "names another service");
+              return;
+            }
+            if (heartbeats) heartbeats->heard(service, m.service, wall_seconds());
             loss.heard(m);
           },
           ofn::SubscribeOptions{0.0, 0.0});
