@@ -10,7 +10,11 @@
 // Before the flood it listens for every service's heartbeat and takes the
 // flight's own messages as the seeds of their channels (a channel nobody
 // publishes keeps a built-in seed); during it, stamps follow SIM_CLOCK (the
-// wall clock on a bus without one). Every `--forgery-every` messages it
+// wall clock on a bus without one). A fuzz message that its type's decode
+// and validation would accept (an extreme but finite number, noise that
+// lands well) is a forgery, not malformed input, and is withheld unless
+// --send-valid; one whose only fault is a stamp far from now is sent, for
+// the receivers' time checks. Every `--forgery-every` messages it
 // also sends well-formed forgeries stamped with the simulation's own time,
 // which a service must refuse: a SIM_CLOCK 1,000 s ahead, a CONTROL_STATUS
 // saying DONE mid-flight, a REF_TRAJ at five times the speed limit and an
@@ -23,6 +27,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -174,11 +179,11 @@ int main(int argc, char** argv) {
   int64_t messages = 5000;
   double rate = 2000.0;
   double wait = 30.0;
-  double listen = 3.0;
+  double listen = 3.0, after = 4.0;
   int forgery_every = 100;
   uint64_t seed = 42;
-  std::string report_path;
-  bool builtin_seeds = false;
+  std::string report_path, valid_path;
+  bool builtin_seeds = false, send_valid = false;
   app.add_option("--lcm-url", url, "LCM URL of the bus to attack");
   app.add_option("--messages", messages, "fuzz messages to send")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 40));
@@ -191,14 +196,31 @@ int main(int argc, char** argv) {
   app.add_option("--listen", listen,
                  "seconds to listen for the flight's own messages (the seeds) before the flood")
       ->check(CLI::Range(0.0, 3600.0));
+  app.add_option("--after", after,
+                 "seconds to listen for every service's heartbeat after the flood (they come "
+                 "once a second of the simulation's time)")
+      ->check(CLI::Range(1.0, 3600.0));
   app.add_option("--forgery-every", forgery_every,
                  "send the four well-formed forgeries after every N fuzz messages; 0 = never")
       ->check(CLI::Range(0, 1 << 30));
   app.add_option("--seed", seed, "seed of the random parts (the same seed, the same messages)");
   app.add_flag("--builtin-seeds", builtin_seeds,
                "mutate the built-in seed of every channel, not the flight's own messages");
+  app.add_flag("--send-valid", send_valid,
+               "also send what its type's decode and validation accept (an extreme but finite "
+               "number, noise that lands well): forgeries for the command gate; stamps far "
+               "from now are sent either way");
   app.add_option("--report", report_path,
                  "write what was sent and what each service counted to this JSON file "
+                 "(default: none)");
+  std::vector<std::string> only;
+  app.add_option("--channel", only,
+                 "fuzz only this channel of the channel table (a family by its prefix, "
+                 "HEARTBEAT_); repeat for more (default: every channel)");
+  app.add_option("--valid-log", valid_path,
+                 "write every fuzz message that its type's decode and validation accept to "
+                 "this file (a 2-byte channel length, the channel, a 4-byte length, the "
+                 "bytes; big-endian), so that a recording can be judged without them "
                  "(default: none)");
   std::string sign_as, bus_keys;
   app.add_option("--sign-as", sign_as,
@@ -238,11 +260,28 @@ int main(int argc, char** argv) {
     for (const auto& s : services) names.push_back(entry.name + upper(s));
     names.push_back(std::string(entry.name) + "FUZZ");
   }
+  // Every channel has a generator, or none is fuzzed; --channel then picks.
+  static std::vector<ofn::ChannelInfo> table = ofn::channel_table();
   std::optional<ofn::fuzz::Fuzzer> fuzzer;
   try {
     static const ofn::fuzz::Schema schema =
         ofn::fuzz::Schema::parse(ofn::fuzz::builtin_lcm_sources());
-    fuzzer.emplace(schema, ofn::channel_table(), ofn::fuzz::message_supports(), families, seed);
+    fuzzer.emplace(schema, table, ofn::fuzz::message_supports(), families, seed);
+    if (!only.empty()) {
+      std::vector<ofn::ChannelInfo> picked;
+      for (const auto& name : only) {
+        const auto it = std::find_if(table.begin(), table.end(),
+                                     [&](const ofn::ChannelInfo& c) { return name == c.name; });
+        if (it == table.end()) {
+          std::cerr << "ofn_bus_fuzz: --channel " << name << ": not in the channel table\n";
+          return 2;
+        }
+        picked.push_back(*it);
+      }
+      fuzzer.reset();
+      table = picked;
+      fuzzer.emplace(schema, table, ofn::fuzz::message_supports(), families, seed);
+    }
   } catch (const std::exception& e) {
     // A channel without a generator: the fuzz would leave it out.
     std::cerr << "ofn_bus_fuzz: " << e.what() << "\n";
@@ -289,8 +328,27 @@ int main(int argc, char** argv) {
   std::cout << "fuzz: seeds from the flight on" << (taken.empty() ? " no channel" : taken)
             << "; built-in seeds on the others" << std::endl;
 
+  std::ofstream valid_log;
+  if (!valid_path.empty()) {
+    valid_log.open(valid_path, std::ios::binary);
+    if (!valid_log) {
+      std::cerr << "ofn_bus_fuzz: cannot write " << valid_path << "\n";
+      return 2;
+    }
+  }
+  const auto record_valid = [&valid_log](const ofn::fuzz::FuzzMessage& m) {
+    const auto put = [&valid_log](uint64_t v, int bytes) {
+      for (int i = bytes - 1; i >= 0; --i) valid_log.put(static_cast<char>(v >> (8 * i)));
+    };
+    put(m.channel.size(), 2);
+    valid_log.write(m.channel.data(), static_cast<std::streamsize>(m.channel.size()));
+    put(m.bytes.size(), 4);
+    valid_log.write(reinterpret_cast<const char*>(m.bytes.data()),
+                    static_cast<std::streamsize>(m.bytes.size()));
+  };
+
   // The flood, paced: message i goes at start + i / rate.
-  std::map<std::string, int64_t> by_kind, by_channel;
+  std::map<std::string, int64_t> by_kind, by_channel, valid_by_kind, withheld_by_kind;
   int64_t sent = 0, forgeries = 0, bytes_sent = 0;
   const auto start = Clock::now();
   std::cout << "fuzz: flooding " << messages << " messages at " << rate << "/s on "
@@ -301,8 +359,17 @@ int main(int argc, char** argv) {
         messages, static_cast<int64_t>(std::floor(seconds_since(start) * rate)) + 1);
     while (sent < due) {
       const ofn::fuzz::FuzzMessage m = fuzzer->next(listener.now());
+      if (m.valid && m.kind != ofn::fuzz::Kind::kStamp && !send_valid) {
+        // A forgery, not malformed input: the command gate's to judge.
+        ++withheld_by_kind[ofn::fuzz::kind_name(m.kind)];
+        continue;
+      }
       mouth.publish(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
       ++by_kind[ofn::fuzz::kind_name(m.kind)];
+      if (m.valid) {
+        ++valid_by_kind[ofn::fuzz::kind_name(m.kind)];
+        if (valid_log.is_open()) record_valid(m);
+      }
       ++by_channel[m.channel];
       bytes_sent += static_cast<int64_t>(m.bytes.size());
       ++sent;
@@ -322,14 +389,26 @@ int main(int argc, char** argv) {
           std::min(next_due, Clock::now() + std::chrono::milliseconds(5)));
   }
   const double took = seconds_since(start);
+  if (valid_log.is_open()) {
+    valid_log.close();
+    if (!valid_log) {
+      std::cerr << "ofn_bus_fuzz: cannot write " << valid_path << "\n";
+      return 2;
+    }
+  }
+  int64_t valid = 0, withheld = 0;
+  for (const auto& [kind, n] : valid_by_kind) valid += n;
+  for (const auto& [kind, n] : withheld_by_kind) withheld += n;
   std::cout << "fuzz: flood done: " << sent << " messages (" << bytes_sent / 1000000.0
-            << " MB) and " << forgeries << " forgeries in " << took << " s" << std::endl;
+            << " MB) and " << forgeries << " forgeries in " << took << " s; " << valid
+            << " of them valid to their type's decode and validation (far stamps); " << withheld
+            << " other valid ones withheld (without --send-valid)" << std::endl;
 
   // Heartbeats come once a second of (simulated) time; listen long enough
   // for every service's next two.
   listener.heartbeats.clear();
   const auto after_start = Clock::now();
-  while (seconds_since(after_start) < 4.0) ear.handleTimeout(100);
+  while (seconds_since(after_start) < after) ear.handleTimeout(100);
 
   int failures = 0;
   nlohmann::json report;
@@ -340,6 +419,8 @@ int main(int argc, char** argv) {
   report["rate"] = sent / took;
   report["by_kind"] = by_kind;
   report["by_channel"] = by_channel;
+  report["valid_by_kind"] = valid_by_kind;
+  report["withheld_by_kind"] = withheld_by_kind;
   report["seeds_from_flight"] = nlohmann::json::array();
   for (const auto& [channel, n] : listener.seeds_taken)
     report["seeds_from_flight"].push_back(channel);

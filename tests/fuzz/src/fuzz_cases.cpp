@@ -435,6 +435,7 @@ FuzzMessage Fuzzer::make(Channel& c, const Mutation& m, Utime now) {
       break;
     }
   }
+  out.valid = c.support->check(bytes.data(), bytes.size()).empty();
   out.bytes = std::move(bytes);
   return out;
 }

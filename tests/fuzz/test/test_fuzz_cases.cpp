@@ -121,6 +121,7 @@ TEST(Fuzzer, EveryBrokenMessageIsRefusedByDecodeOrValidate) {
     const std::string channel = entry.prefix ? "HEARTBEAT_FUZZ" : entry.name;
     const MessageSupport& support = *find_message_support(entry.type);
     for (const auto& m : fuzzer.all_of(channel, kNow)) {
+      EXPECT_EQ(m.valid, support.check(m.bytes.data(), m.bytes.size()).empty()) << m.what;
       const bool must_refuse = m.kind == Kind::kTruncated || m.kind == Kind::kWrongFingerprint ||
                                m.kind == Kind::kSizeField || m.kind == Kind::kStringLength ||
                                m.kind == Kind::kNonFinite;

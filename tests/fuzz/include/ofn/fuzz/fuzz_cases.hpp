@@ -68,6 +68,10 @@ struct FuzzMessage {
   /// The type and the place and value the fuzz wrote ("nav_state_t
   /// position[1] = NaN").
   std::string what;
+  /// True when the channel type's decode and validate() accept it (an
+  /// extreme but finite number, a stamp other than utime): only a
+  /// receiver's time check and its own judgement stand before it.
+  bool valid = false;
 };
 
 /// The cases of one seed: which place, which value. `variant` picks the
