@@ -490,7 +490,8 @@ class PythonEntryPointTest(ScratchTestCase):
         bad_number = self.write("bad.csv", SWEEP_HEADER + '1.2,"nominal",ten,light,0.5,1.1,0.9,2.0\n')
         bin_dir = os.path.join(d, "bin")
         os.makedirs(bin_dir)
-        write_executable(os.path.join(bin_dir, "ofn_sim_runner"), "#!/bin/sh\nexit 1\n")
+        for program in ("ofn_sim_runner", "ofn_bus_fuzz", "ofn_flight_report"):
+            write_executable(os.path.join(bin_dir, program), "#!/bin/sh\nexit 1\n")
         types = os.path.join(d, "types")
         self.write("types/ofn/__init__.py", "class nav_state_t:\n    pass\n")
         log = self.write("flight.lcm", "not a log\n")
@@ -501,6 +502,13 @@ class PythonEntryPointTest(ScratchTestCase):
                 (["--bin", missing], "no ofn_sim_runner in " + missing, False),
                 (["--bin", bin_dir, "--config-dir", missing], "--config-dir", False),
                 (["--bin", bin_dir, "--quick", "--out", missing], "python3-yaml", True),
+            ],
+            "bench/bus_fuzz.py": [
+                (["--bin", bin_dir, "--scenario", missing], "--scenario: no file", False),
+                (["--bin", bin_dir, "--messages", "0"], "--messages must be >= 1", False),
+                (["--bin", bin_dir, "--rate", "-5"], "--rate must be > 0", False),
+                (["--bin", missing], "no ofn_bus_fuzz in " + missing, False),
+                (["--bin", bin_dir, "--out", missing], "python3-yaml", True),
             ],
             "bench/campaign_report.py": [
                 ([missing], "no folder", False),
