@@ -346,7 +346,8 @@ def without_fuzz(log, valid, filtered):
 
 def flight_report(args, out):
     """The flight's verdict from ofn_flight_report (outcome, its reasons),
-    on the recording without the fuzz's valid messages."""
+    on the recording without the fuzz's valid messages; and the paths of
+    the logs read."""
     run = os.path.join(out, "run")
     try:
         with open(os.path.join(run, "latest_log")) as f:
@@ -434,10 +435,14 @@ def write_report(args, out, services, results):
             f.get("rejected_after", 0) - f.get("rejected_before", 0) if f.get("alive") else "-",
             mb(r, "before_mb"), mb(r, "peak_during_mb"), mb(r, "after_mb"),
             mb(r, "control_after_mb"), mb(r, "excess_mb", "%+.1f")))
-    v = results["flight"]
+    def verdict(v):
+        return "%s%s" % (v.get("outcome"),
+                         " (%s)" % "; ".join(v["failures"]) if v.get("failures") else "")
+
     lines += ["", "Flight: %s%s; crashes %d, restarts %d." % (
-        v.get("outcome"), " (%s)" % "; ".join(v["failures"]) if v.get("failures") else "",
-        results["crashes"], results["restarts"]),
+        verdict(results["flight"]),
+        "; without the fuzz: " + verdict(results["control_flight"])
+        if results.get("control_flight") else "", results["crashes"], results["restarts"]),
               "", "Assertions: %s" % ("all hold" if not results["failures"] else
                                       "; ".join(results["failures"]))]
     with open(os.path.join(out, "report.md"), "w") as f:
@@ -468,6 +473,7 @@ def main(argv=None):
     timeout = max(max_time / args.rtf + 30.0, flood_s + 90.0)
     wall_start = time.monotonic()
     control_csv = None
+    control_verdict = None
     if not args.no_control:
         print("fuzz: the control flight: %s at rtf %g without the fuzz, in %s/control"
               % (os.path.relpath(args.scenario, REPO), args.rtf, out))
@@ -475,8 +481,14 @@ def main(argv=None):
         os.makedirs(control_dir, exist_ok=True)
         code, _ = fly(args, os.path.join(control_dir, "run"), control_dir, timeout)
         control_csv = Marks(os.path.join(control_dir, "run")).csv()
-        for log in glob.glob(os.path.join(control_dir, "run", "*.lcm")):
-            os.remove(log)  # its memory is what is compared, not its flight
+        control_verdict, logs = flight_report(args, control_dir)
+        print("fuzz: the control flight: %s%s" % (
+            control_verdict.get("outcome"), " (%s)" % "; ".join(control_verdict["failures"])
+            if control_verdict.get("failures") else ""))
+        if not args.keep_log:
+            for path in logs:
+                if os.path.exists(path):
+                    os.remove(path)
         if code not in (0, 1) or control_csv is None:
             print("fuzz: the control flight failed to run (launcher exit code %d)" % code)
             return 1
@@ -503,7 +515,8 @@ def main(argv=None):
                "scenario": os.path.relpath(args.scenario, REPO), "rtf": args.rtf,
                "rate": args.rate, "rss_bound_mb": args.rss_bound,
                "wall_seconds": round(time.monotonic() - wall_start, 1),
-               "fuzz": fuzz, "rss": rss, "flight": verdict, "crashes": crashes,
+               "fuzz": fuzz, "rss": rss, "flight": verdict, "control_flight": control_verdict,
+               "crashes": crashes,
                "restarts": restarts, "launcher_exit_code": launcher_code,
                "failures": failures}
     for line in write_report(args, out, services, results):
