@@ -3,6 +3,8 @@
 // clock, and the service's timers fired in order as the clock advances.
 
 #include <algorithm>
+#include <cstdint>
+#include <initializer_list>
 #include <string>
 
 #include <lcm/lcm-cpp.hpp>
@@ -29,17 +31,19 @@ class ServiceTestBus {
 
   /// Moves the clock to t, firing the node's timers on the way (timers are
   /// scheduled by their first firing) and delivering what they publish.
-  void advance_to(Node& node, Utime t) {
+  void advance_to(Node& node, Utime t) { advance_to({&node}, t); }
+
+  /// The same for a service and the test's own nodes (a stand-in
+  /// publisher, a recorder): at each step the clock moves to the earliest
+  /// deadline among them, every node fires the timers then due, and what
+  /// they publish is delivered before time moves on.
+  void advance_to(std::initializer_list<Node*> nodes, Utime t) {
     while (true) {
-      const Utime next = node.next_deadline();
-      if (next == INT64_MIN) {
-        node.fire_due_timers();
-      } else if (next <= t) {
-        clock_.set(std::max(clock_.now(), next));
-        node.fire_due_timers();
-      } else {
-        break;
-      }
+      Utime next = INT64_MAX;
+      for (const Node* n : nodes) next = std::min(next, n->next_deadline());
+      if (next != INT64_MIN && next > t) break;
+      clock_.set(std::max(clock_.now(), next));
+      for (Node* n : nodes) n->fire_due_timers();
       deliver();
     }
     clock_.set(t);
