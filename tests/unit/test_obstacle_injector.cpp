@@ -1,4 +1,4 @@
-// The obstacle injector on the lockstep bus: what a subscriber to
+// The obstacle injector on an in-process bus: what a subscriber to
 // VIRTUAL_OBSTACLES sees as obstacles pop up and vanish on the scenario's
 // schedule, and when the scenario file is edited while running.
 
@@ -18,8 +18,8 @@
 #include "ofn/common/logging.hpp"
 #include "ofn/common/validate/virtual_obstacles.hpp"
 #include "ofn/obstacle_injector/obstacle_injector_service.hpp"
-#include "ofn/sim/lockstep.hpp"
 #include "ofn/virtual_obstacles_t.hpp"
+#include "service_test_bus.hpp"
 
 namespace ofn {
 namespace {
@@ -113,7 +113,7 @@ class ObstacleInjector : public ::testing::Test {
     std::ofstream(path_) << kScenario;
     probe_.subscribe<virtual_obstacles_t>(channels::kVirtualObstacles,
                                           [this](const virtual_obstacles_t& m) {
-                                            received_.push_back({lockstep_.clock().now(), m});
+                                            received_.push_back({bus_.now(), m});
                                           });
   }
   void TearDown() override {
@@ -140,16 +140,15 @@ class ObstacleInjector : public ::testing::Test {
 
   fs::path dir_;
   std::string path_;
-  sim::Lockstep lockstep_;
-  Node probe_{"probe", lockstep_.lcm(), lockstep_.clock()};
+  testing_support::ServiceTestBus bus_{0};
+  Node probe_{"probe", bus_.lcm(), bus_.clock()};
   std::vector<Received> received_;
 };
 
 TEST_F(ObstacleInjector, FirstMessageCarriesThePresentObstaclesInSI) {
-  ObstacleInjectorService service(lockstep_.lcm(), lockstep_.clock(), path_);
-  lockstep_.add(service.node());
+  ObstacleInjectorService service(bus_.lcm(), bus_.clock(), path_);
   EXPECT_EQ(service.revision(), 0);
-  lockstep_.run(0);
+  bus_.advance_to(service.node(), 0);
 
   ASSERT_EQ(received_.size(), 1u);
   const virtual_obstacles_t& m = received_[0].msg;
@@ -176,9 +175,8 @@ TEST_F(ObstacleInjector, FirstMessageCarriesThePresentObstaclesInSI) {
 TEST_F(ObstacleInjector, PopUpAppearsWithinOneCheckPeriodWithAHigherRevision) {
   ObstacleInjectorConfig config;
   config.check_rate = 20.0;
-  ObstacleInjectorService service(lockstep_.lcm(), lockstep_.clock(), path_, config);
-  lockstep_.add(service.node());
-  lockstep_.run(to_utime(5.0));
+  ObstacleInjectorService service(bus_.lcm(), bus_.clock(), path_, config);
+  bus_.advance_to(service.node(), to_utime(5.0));
 
   const auto first_with_2 = std::find_if(received_.begin(), received_.end(),
                                          [](const Received& r) { return contains(r.msg, 2); });
@@ -192,9 +190,8 @@ TEST_F(ObstacleInjector, PopUpAppearsWithinOneCheckPeriodWithAHigherRevision) {
 }
 
 TEST_F(ObstacleInjector, RemovedObstacleDisappearsAtItsTime) {
-  ObstacleInjectorService service(lockstep_.lcm(), lockstep_.clock(), path_);
-  lockstep_.add(service.node());
-  lockstep_.run(to_utime(5.0));
+  ObstacleInjectorService service(bus_.lcm(), bus_.clock(), path_);
+  bus_.advance_to(service.node(), to_utime(5.0));
 
   const auto first_without_3 = std::find_if(received_.begin(), received_.end(),
                                             [](const Received& r) { return !contains(r.msg, 3); });
@@ -212,10 +209,9 @@ TEST_F(ObstacleInjector, RemovedObstacleDisappearsAtItsTime) {
 TEST_F(ObstacleInjector, UnchangedSetIsResentEveryPeriodWithTheSameRevision) {
   ObstacleInjectorConfig config;
   config.publish_period = 0.5;
-  ObstacleInjectorService service(lockstep_.lcm(), lockstep_.clock(), path_, config);
-  lockstep_.add(service.node());
+  ObstacleInjectorService service(bus_.lcm(), bus_.clock(), path_, config);
   // Nothing changes before the pop-up at 2 s.
-  lockstep_.run(to_utime(1.9));
+  bus_.advance_to(service.node(), to_utime(1.9));
 
   ASSERT_EQ(received_.size(), 4u);  // 0, 0.5, 1.0, 1.5 s
   for (size_t i = 0; i < received_.size(); ++i) {
@@ -229,9 +225,8 @@ TEST_F(ObstacleInjector, UnchangedSetIsResentEveryPeriodWithTheSameRevision) {
 TEST_F(ObstacleInjector, ResendPeriodRestartsAfterAChange) {
   ObstacleInjectorConfig config;
   config.publish_period = 0.75;
-  ObstacleInjectorService service(lockstep_.lcm(), lockstep_.clock(), path_, config);
-  lockstep_.add(service.node());
-  lockstep_.run(to_utime(4.6));
+  ObstacleInjectorService service(bus_.lcm(), bus_.clock(), path_, config);
+  bus_.advance_to(service.node(), to_utime(4.6));
   // Re-sends a period after the last message, whether that was a change
   // (pop-up at 2 s, removal at 3 s) or a re-send.
   std::vector<Utime> times;
@@ -247,13 +242,12 @@ TEST_F(ObstacleInjector, ResendPeriodRestartsAfterAChange) {
 }
 
 TEST_F(ObstacleInjector, BadFileEditKeepsTheOldSetAndAGoodOneIsPublished) {
-  ObstacleInjectorService service(lockstep_.lcm(), lockstep_.clock(), path_);
-  lockstep_.add(service.node());
-  lockstep_.run(to_utime(0.5));
+  ObstacleInjectorService service(bus_.lcm(), bus_.clock(), path_);
+  bus_.advance_to(service.node(), to_utime(0.5));
   ASSERT_EQ(service.revision(), 1);
 
   edit("obstacles:\n  - kind: pyramid\n");
-  lockstep_.run(to_utime(1.5));
+  bus_.advance_to(service.node(), to_utime(1.5));
   EXPECT_EQ(service.revision(), 1);
   EXPECT_EQ(service.present_ids(), (std::vector<int>{1, 3}));
   const auto after_bad = since(0.6);
@@ -263,7 +257,7 @@ TEST_F(ObstacleInjector, BadFileEditKeepsTheOldSetAndAGoodOneIsPublished) {
   EXPECT_DOUBLE_EQ(after_bad.back().msg.ground_altitude, 4.0);
 
   edit(kEditedScenario);
-  lockstep_.run(to_utime(2.5));
+  bus_.advance_to(service.node(), to_utime(2.5));
   EXPECT_EQ(service.revision(), 2);
   EXPECT_EQ(service.present_ids(), (std::vector<int>{1, 4}));
   const auto after_good = since(1.51);
@@ -279,7 +273,7 @@ TEST_F(ObstacleInjector, BadFileEditKeepsTheOldSetAndAGoodOneIsPublished) {
   std::string moved = kEditedScenario;
   moved.replace(moved.find("center: [45, -5]"), 16, "center: [50, -5]");
   edit(moved);
-  lockstep_.run(to_utime(3.0));
+  bus_.advance_to(service.node(), to_utime(3.0));
   EXPECT_EQ(service.revision(), 3);
   EXPECT_EQ(service.present_ids(), (std::vector<int>{1, 4}));
   const auto after_move = since(2.51);
@@ -291,19 +285,18 @@ TEST_F(ObstacleInjector, BadFileEditKeepsTheOldSetAndAGoodOneIsPublished) {
 TEST_F(ObstacleInjector, ScheduleCountsFromTheFirstCheckNotFromClockZero) {
   // A service started late (here at clock 100 s) still pops obstacle 2 up
   // 2 s into its own mission.
-  lockstep_.clock().set(to_utime(100.0));
-  ObstacleInjectorService service(lockstep_.lcm(), lockstep_.clock(), path_);
-  lockstep_.add(service.node());
-  lockstep_.run(to_utime(101.9));
+  bus_.clock().set(to_utime(100.0));
+  ObstacleInjectorService service(bus_.lcm(), bus_.clock(), path_);
+  bus_.advance_to(service.node(), to_utime(101.9));
   EXPECT_EQ(service.present_ids(), (std::vector<int>{1, 3}));
-  lockstep_.run(to_utime(102.0));
+  bus_.advance_to(service.node(), to_utime(102.0));
   EXPECT_EQ(service.present_ids(), (std::vector<int>{1, 2, 3}));
   EXPECT_NEAR(service.mission_time(), 2.0, 1e-9);
 }
 
 TEST_F(ObstacleInjector, BadScenarioAtStartIsAConfigError) {
   edit("name: broken\n");
-  EXPECT_THROW(ObstacleInjectorService(lockstep_.lcm(), lockstep_.clock(), path_), ConfigError);
+  EXPECT_THROW(ObstacleInjectorService(bus_.lcm(), bus_.clock(), path_), ConfigError);
 }
 
 TEST(ObstacleInjectorSchedule, PresentFromAppearUntilBeforeDisappear) {
