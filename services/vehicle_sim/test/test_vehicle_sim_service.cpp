@@ -1,6 +1,6 @@
-// vehicle_sim's service: its config file (the LIDAR section: defaults,
-// degrees, the shipped file, errors naming the field) and LIDAR_RAW of the
-// injected obstacles on an in-process bus.
+// vehicle_sim's service: its config file (rates, the airframe, the LIDAR
+// section: defaults, degrees, the shipped file, errors naming the file and
+// the field) and LIDAR_RAW of the injected obstacles on an in-process bus.
 
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "config_files.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/config.hpp"
 #include "ofn/common/logging.hpp"
@@ -22,6 +23,8 @@
 namespace ofn::vehicle {
 namespace {
 
+using testing_support::ConfigFiles;
+
 constexpr int kWallId = 5;
 
 /// A wall across the north at `north_face`, far above every beam.
@@ -34,6 +37,38 @@ ObstacleSpec wall_spec(double north_face, double ground_altitude) {
   s.width = 400.0;
   s.height = 2000.0 - ground_altitude;
   return s;
+}
+
+TEST_F(ConfigFiles, VehicleSimNavRateAbovePhysicsRateIsAnError) {
+  const std::string path = write("sim.yaml", "physics_rate_hz: 200\nnav_rate_hz: 500\n");
+  auto reader = YamlReader::load_file(path);
+  try {
+    load_vehicle_sim_config(reader);
+    FAIL() << "loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NAMES(std::string(e.what()), path, "nav_rate_hz");
+  }
+}
+
+TEST_F(ConfigFiles, VehicleSimConfigReadsAirframe) {
+  const std::string path =
+      write("sim.yaml", "physics_rate_hz: 500\nairframe:\n  mass: 70\n  inertia: [7, 20, 16]\n");
+  auto reader = YamlReader::load_file(path);
+  const auto c = load_vehicle_sim_config(reader);
+  EXPECT_DOUBLE_EQ(c.physics_rate, 500.0);
+  EXPECT_DOUBLE_EQ(c.params.mass, 70.0);
+  EXPECT_TRUE(c.params.inertia.isApprox(Vec3(7, 20, 16)));
+}
+
+TEST_F(ConfigFiles, VehicleSimUnknownAirframeFieldIsNamed) {
+  const std::string path = write("sim.yaml", "airframe:\n  mas: 70\n");
+  auto reader = YamlReader::load_file(path);
+  try {
+    load_vehicle_sim_config(reader);
+    FAIL() << "loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NAMES(std::string(e.what()), path, "airframe.mas");
+  }
 }
 
 class LidarConfigFile : public ::testing::Test {
