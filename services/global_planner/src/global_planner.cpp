@@ -52,6 +52,8 @@ GlobalPlanner::GlobalPlanner(GlobalPlannerConfig config) : config_(config) {
       !positive(config_.path_spacing))
     throw std::invalid_argument(
         "global planner: clearance, speed, max_accel and path_spacing must be positive");
+  if (!(std::isfinite(config_.vertical_speed) && config_.vertical_speed >= 0.0))
+    throw std::invalid_argument("global planner: vertical_speed must be 0 (off) or positive");
   if (!(config_.min_altitude < config_.max_altitude))
     throw std::invalid_argument("global planner: min_altitude must be below max_altitude");
 }
@@ -90,7 +92,7 @@ PlanResult GlobalPlanner::plan_with(const PlanRequest& request, bool any_directi
   result.cost = 0.0;
   for (size_t k = 0; k < sequence.size(); ++k) {
     result.waypoints.push_back(cuboid_graph.nodes()[sequence[k]]);
-    if (k > 0) result.cost += cuboid_graph.length(sequence[k - 1], sequence[k]);
+    if (k > 0) result.cost += cuboid_graph.cost(sequence[k - 1], sequence[k]);
   }
   result.path = interpolate(result.waypoints, config_.path_spacing);
   return result;
@@ -106,7 +108,7 @@ PlanGraph GlobalPlanner::build_graph(const PlanRequest& request) const {
     for (int j = 0; j < n; ++j) {
       if (i == j || j == 0 || i == 1 || !cuboid_graph.shape_ok(i, j)) continue;
       if (!cuboid_graph.blocked(i, j))
-        graph.cost[static_cast<size_t>(i) * n + j] = cuboid_graph.length(i, j);
+        graph.cost[static_cast<size_t>(i) * n + j] = cuboid_graph.cost(i, j);
     }
   return graph;
 }

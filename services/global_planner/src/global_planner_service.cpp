@@ -64,6 +64,7 @@ GlobalPlannerServiceConfig load_global_planner_config(YamlReader& r) {
   c.max_obstacles = r.integer("max_obstacles", c.max_obstacles);
   if (c.max_obstacles < 1 || c.max_obstacles > 100000)
     r.fail("max_obstacles", "expected 1..100000");
+  c.time_cost = r.boolean("time_cost", c.time_cost);
   r.finish();
   return c;
 }
@@ -73,6 +74,7 @@ GlobalPlannerConfig planner_config_for(const GlobalPlannerServiceConfig& s, cons
   c.clearance = m.limits.clearance;
   c.max_accel = m.limits.max_accel;
   c.speed = std::min(m.cruise_speed, m.limits.max_speed);
+  c.vertical_speed = s.time_cost ? m.limits.max_vertical_speed : 0.0;
   c.merge_distance = s.merge_distance;
   c.ground_altitude = s.ground_altitude;
   c.min_altitude = s.min_altitude;

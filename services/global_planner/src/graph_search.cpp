@@ -24,7 +24,7 @@ std::vector<int> sequence_to_goal(const std::vector<char>& closed, const std::ve
 }
 
 struct Entry {
-  double f;  // cost so far plus the straight distance to the goal
+  double f;  // cost so far plus the straight way's cost to the goal
   double g;
   int node;
   int parent;
@@ -38,7 +38,7 @@ std::vector<int> search_forward(CuboidGraph& graph) {
   const int n = graph.size();
   const Vec3 goal = graph.nodes()[1];
   std::vector<double> h(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) h[i] = (goal - graph.nodes()[i]).norm();
+  for (int i = 0; i < n; ++i) h[i] = graph.segment_cost(graph.nodes()[i], goal);
 
   // Only nodes strictly between the start and the goal along the leg can
   // lie on a path; sorted along the leg so a closed node scans only those
@@ -72,7 +72,7 @@ std::vector<int> search_forward(CuboidGraph& graph) {
     for (size_t k = static_cast<size_t>(first); k < ahead.size(); ++k) {
       const int w = ahead[k];
       if (closed[w]) continue;
-      const double offer = cost + graph.length(v, w);
+      const double offer = cost + graph.cost(v, w);
       if (!exhaustive[w] && offer >= best_offer[w]) continue;
       if (!graph.shape_ok(v, w)) continue;
       if (!exhaustive[w]) {
@@ -107,7 +107,7 @@ std::vector<int> search_forward(CuboidGraph& graph) {
     exhaustive[e.node] = 1;
     for (int u : closed_list) {
       if (u == e.parent || !graph.shape_ok(u, e.node)) continue;
-      const double offer = g[u] + graph.length(u, e.node);
+      const double offer = g[u] + graph.cost(u, e.node);
       open.push({offer + h[e.node], offer, e.node, u, true});
     }
   }
@@ -128,8 +128,8 @@ std::vector<int> search_any_direction(CuboidGraph& graph) {
     if (v == 1) return;
     for (int w = 1; w < n; ++w) {
       if (closed[w] || w == v) continue;
-      const double offer = cost + graph.length(v, w);
-      open.push({offer + (goal - graph.nodes()[w]).norm(), offer, w, v, false});
+      const double offer = cost + graph.cost(v, w);
+      open.push({offer + graph.segment_cost(graph.nodes()[w], goal), offer, w, v, false});
     }
   };
   close(0, 0.0, -1);

@@ -218,12 +218,37 @@ TEST(CuboidGraph, AStartInsideTheClearanceMayLeaveButNotCrossTheCuboid) {
 // Dijkstra over every segment the graph's blocked() allows, any direction.
 double dijkstra_any_direction(CuboidGraph& graph) {
   return test::dijkstra(graph.size(), [&](int u, int v) {
-    return v == 0 || v == u || graph.blocked(u, v) ? kInf : graph.length(u, v);
+    return v == 0 || v == u || graph.blocked(u, v) ? kInf : graph.cost(u, v);
   });
 }
 
+void expect_any_direction_optimal(double vertical_speed);
+
 TEST(GraphSearch, AnyDirectionFindsWhatDijkstraFindsAndNeverCostsMoreThanForward) {
+  // Segments costing their length, and their flight time within a
+  // vertical speed limit (then the estimate is that time's cost too).
+  for (const double vertical_speed : {0.0, 1.524}) {
+    SCOPED_TRACE(testing::Message() << "vertical speed " << vertical_speed);
+    expect_any_direction_optimal(vertical_speed);
+  }
+}
+
+TEST(CuboidGraph, ASegmentCostsItsLengthOrItsTimeWithinBothLimits) {
   GlobalPlannerConfig config;
+  const PlanRequest request = request_along_north({});
+  CuboidGraph by_length(config, request);
+  const Vec3 a(0, 0, -40), shallow(40, 0, -50), steep(10, 0, -70);
+  EXPECT_DOUBLE_EQ(by_length.segment_cost(a, steep), (steep - a).norm());
+  config.vertical_speed = config.speed / 2;
+  CuboidGraph by_time(config, request);
+  EXPECT_DOUBLE_EQ(by_time.segment_cost(a, shallow), (shallow - a).norm());  // 14 deg
+  EXPECT_DOUBLE_EQ(by_time.segment_cost(a, steep), 2 * 30.0);                // 72 deg
+  EXPECT_DOUBLE_EQ(by_time.segment_cost(steep, a), 2 * 30.0);                // down as up
+}
+
+void expect_any_direction_optimal(double vertical_speed) {
+  GlobalPlannerConfig config;
+  config.vertical_speed = vertical_speed;
   int compared = 0;
   for (unsigned seed = 1; seed <= 25; ++seed) {
     std::mt19937 rng(seed);
@@ -246,7 +271,7 @@ TEST(GraphSearch, AnyDirectionFindsWhatDijkstraFindsAndNeverCostsMoreThanForward
     auto cost = [&](const std::vector<int>& sequence) {
       double c = 0.0;
       for (size_t k = 1; k < sequence.size(); ++k)
-        c += any_graph.length(sequence[k - 1], sequence[k]);
+        c += any_graph.cost(sequence[k - 1], sequence[k]);
       return c;
     };
     if (reference == kInf) {

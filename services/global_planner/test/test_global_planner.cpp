@@ -91,7 +91,10 @@ void expect_valid_path(const GlobalPlannerConfig& config, const PlanRequest& req
   for (size_t k = 1; k < result.waypoints.size(); ++k) {
     const Vec3 d =
         frame.to_guidance(result.waypoints[k]) - frame.to_guidance(result.waypoints[k - 1]);
-    cost += d.norm();
+    const Vec3 world = result.waypoints[k] - result.waypoints[k - 1];
+    cost += config.vertical_speed > 0
+                ? std::max(world.norm(), std::abs(world.z()) * config.speed / config.vertical_speed)
+                : world.norm();
     ASSERT_GT(d.x(), 0.1) << "segment " << k << " does not advance along the leg";
     const bool first = k == 1 && v.x() >= 0.5;
     const double a_y = eq10_accel(d.y(), d.x(), first ? v.y() / v.x() : 0.0, config.speed);
@@ -151,6 +154,76 @@ TEST(GlobalPlanner, LowWallAcrossTheCourseIsClimbedOver) {
   EXPECT_LT(widest_offset(result), 1.0);
   EXPECT_GT(result.nodes, 2);
   EXPECT_GT(result.segments_checked, 0);
+}
+
+TEST(GlobalPlanner, ASteepClimbCostsItsTimeNotItsLength) {
+  // A vehicle hovering 12 m in front of a wall 5 m thick, 80 m wide and
+  // 62 m high, as a dead-end recovery finds it (plan_any_direction: no
+  // Eq. 10 check, the vehicle leaves from rest). Over it is 31.5 m up and
+  // down within 6 m of run each way: shorter than the 46 m sideways round
+  // its end, but at 10 ft/s and 5 ft/s vertically the slower way.
+  PlanRequest request;
+  request.start = Vec3(0.0, 0.0, -kAltitude);
+  request.leg_from = Vec3(-30.0, 0.0, -kAltitude);
+  request.goal = Vec3(40.0, 0.0, -kAltitude);
+  request.obstacles = {box(4, 12, 17, -40, 40, 62)};
+  auto time_of = [](const PlanResult& r) {  // s at 10 ft/s and 5 ft/s vertically
+    double t = 0;
+    for (size_t k = 1; k < r.waypoints.size(); ++k) {
+      const Vec3 d = r.waypoints[k] - r.waypoints[k - 1];
+      t += std::max(d.norm() / 3.048, std::abs(d.z()) / 1.524);
+    }
+    return t;
+  };
+  auto length_of = [](const PlanResult& r) {
+    double l = 0;
+    for (size_t k = 1; k < r.waypoints.size(); ++k)
+      l += (r.waypoints[k] - r.waypoints[k - 1]).norm();
+    return l;
+  };
+
+  GlobalPlannerConfig by_length;
+  const PlanResult over = GlobalPlanner(by_length).plan_any_direction(request);
+  ASSERT_EQ(over.status, PlanStatus::kOk);
+  expect_path_clear(by_length, request.obstacles, over);
+  EXPECT_GE(highest_altitude(over), 62 + by_length.clearance - 1e-6);
+
+  GlobalPlannerConfig by_time;
+  by_time.vertical_speed = 1.524;
+  const PlanResult round = GlobalPlanner(by_time).plan_any_direction(request);
+  ASSERT_EQ(round.status, PlanStatus::kOk);
+  expect_path_clear(by_time, request.obstacles, round);
+  EXPECT_LT(highest_altitude(round), kAltitude + 1.0);
+  EXPECT_GE(widest_offset(round), 40 + by_time.clearance - 1e-6);
+
+  // Each is the better route by its own measure, and the cost is the time
+  // times the speed.
+  EXPECT_LT(length_of(over), length_of(round));
+  EXPECT_LT(time_of(round), time_of(over));
+  EXPECT_NEAR(round.cost, time_of(round) * 3.048, 1e-6);
+  EXPECT_NEAR(over.cost, length_of(over), 1e-6);
+}
+
+TEST(GlobalPlanner, AClimbWithinBothLimitsCostsItsLength) {
+  // The low wall of the course above, climbed over a long run: never
+  // steeper than the two limits allow, so the time cost is the length.
+  const auto request = course_request({box(7, 60, 63, -45, 45, 42.7)});
+  GlobalPlannerConfig by_length, by_time;
+  by_time.vertical_speed = 1.524;
+  const PlanResult a = GlobalPlanner(by_length).plan(request);
+  const PlanResult b = GlobalPlanner(by_time).plan(request);
+  ASSERT_EQ(a.status, PlanStatus::kOk);
+  ASSERT_EQ(b.status, PlanStatus::kOk);
+  EXPECT_EQ(a.waypoints, b.waypoints);
+  EXPECT_NEAR(a.cost, b.cost, 1e-9);
+}
+
+TEST(GlobalPlanner, ANegativeVerticalSpeedIsRefused) {
+  GlobalPlannerConfig config;
+  config.vertical_speed = -1.0;
+  EXPECT_THROW(GlobalPlanner{config}, std::invalid_argument);
+  config.vertical_speed = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(GlobalPlanner{config}, std::invalid_argument);
 }
 
 TEST(GlobalPlanner, TallNarrowTowerIsPassedBeside) {
@@ -349,10 +422,13 @@ TEST(GlobalPlanner, BadNoGoZonesAreIgnored) {
 
 TEST(GlobalPlanner, RandomFieldsGiveSafeOptimalPaths) {
   // Both with the default check (segments leaving the vehicle) and with the
-  // paper's Eq. 10 on every segment.
-  for (const bool strict : {false, true}) {
+  // paper's Eq. 10 on every segment; segments costing their length and
+  // their flight time within a vertical speed limit (5 ft/s).
+  for (const auto& [strict, vertical_speed] :
+       {std::pair{false, 0.0}, {true, 0.0}, {false, 1.524}, {true, 1.524}}) {
     GlobalPlannerConfig config;
     config.accel_check_all_segments = strict;
+    config.vertical_speed = vertical_speed;
     GlobalPlanner planner(config);
     int found = 0;
     for (unsigned seed = 1; seed <= 20; ++seed) {
@@ -375,7 +451,8 @@ TEST(GlobalPlanner, RandomFieldsGiveSafeOptimalPaths) {
       }
     }
     // Most of these sparse fields leave a way through.
-    EXPECT_GE(found, strict ? 10 : 15) << (strict ? "strict" : "default");
+    EXPECT_GE(found, strict ? 10 : 15)
+        << (strict ? "strict" : "default") << ", vertical speed " << vertical_speed;
   }
 }
 

@@ -5,6 +5,8 @@
 // no-go zones). Everything here lives for one call only (step 9).
 // Pure core: world NED, SI units.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <utility>
@@ -44,6 +46,17 @@ class CuboidGraph {
   int segments_checked() const { return segments_checked_; }
 
   double length(int i, int j) const { return (nodes_[j] - nodes_[i]).norm(); }
+  /// What the search minimises for i -> j: segment_cost() of the two nodes.
+  double cost(int i, int j) const { return segment_cost(nodes_[i], nodes_[j]); }
+  /// The cost of a straight segment a -> b: its length, or with a vertical
+  /// speed limit max(length, |rise| * speed / vertical_speed). A metric
+  /// (the larger of two), so the cost of the straight way to the goal is a
+  /// consistent estimate for the search.
+  double segment_cost(const Vec3& a, const Vec3& b) const {
+    const double length = (b - a).norm();
+    if (!(config_.vertical_speed > 0)) return length;
+    return std::max(length, std::abs(b.z() - a.z()) * config_.speed / config_.vertical_speed);
+  }
 
   /// Whether i -> j is a segment of the graph apart from the cuboids: it
   /// advances along the leg and passes the Eq. 10 check.

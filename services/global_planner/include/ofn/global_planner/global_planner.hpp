@@ -5,9 +5,12 @@
 // segments whose cost is their length (blocked when a segment cuts a cuboid
 // or its cubic approximation needs more than the acceleration limit), and
 // dynamic programming for the shortest node sequence from the current
-// position to the target waypoint. The coarse path warm-starts the RH
-// optimiser and decides which way round (over or beside) it goes.
-// Pure core: world NED, SI units, no LCM.
+// position to the target waypoint. With a vertical speed limit a segment
+// costs the time it takes to fly within both limits (as metres of level
+// flight at `speed`): a climb steeper than the two limits allow costs
+// more than its length (see GlobalPlannerConfig::vertical_speed). The coarse path warm-starts the
+// RH optimiser and decides which way round (over or beside) it goes. Pure core: world NED, SI
+// units, no LCM.
 
 #include <limits>
 #include <string>
@@ -32,6 +35,15 @@ struct GlobalPlannerConfig {
   double merge_distance = 3.0;  // m; nodes closer than this merge into one (step 3)
   double speed = 3.048;         // m/s, V of the Eq. 10 acceleration check
   double max_accel = 0.4877;    // m/s^2, limit of the Eq. 10 check
+  /// m/s, the vertical speed limit; 0: a segment costs its length, as in the
+  /// paper's Eq. 9. Above 0 it costs the least time to fly it within the
+  /// speed and the vertical speed limits, in metres of level flight at
+  /// `speed`: max(length, |rise| * speed / vertical_speed). At the
+  /// benchmarks' 10 and 5 ft/s a climb steeper than 30 deg is bound by the
+  /// vertical limit, and a way over a tall obstacle close by can take twice
+  /// the time its length says (dense fields: routes 50 m up and down where
+  /// the time-optimal flight went round).
+  double vertical_speed = 0.0;
   // Eq. 10 assumes every segment starts and ends aligned with the leg. On
   // every segment that makes routes through offset gaps (bench6) or a
   // descent to a near goal (tree) "too sharp" although the optimiser flies
@@ -82,7 +94,9 @@ struct PlanGraph {
 
 struct PlanResult {
   PlanStatus status = PlanStatus::kNoPath;
-  double cost = std::numeric_limits<double>::infinity();  // m, length of the node path
+  /// m: the node path's cost, its length (or, with a vertical speed limit,
+  /// its least flight time times `speed`)
+  double cost = std::numeric_limits<double>::infinity();
   std::vector<Vec3> waypoints;  // chosen nodes, start first and goal last (world NED)
   std::vector<Vec3> path;       // waypoints interpolated every path_spacing (world NED)
   int nodes = 0;                // graph size after merging
@@ -94,7 +108,8 @@ struct PlanResult {
 class GlobalPlanner {
  public:
   /// Throws std::invalid_argument on a non-positive clearance, speed,
-  /// max_accel or path_spacing, or min_altitude >= max_altitude.
+  /// max_accel or path_spacing, a negative or non-finite vertical_speed, or
+  /// min_altitude >= max_altitude.
   explicit GlobalPlanner(GlobalPlannerConfig config = {});
 
   /// Steps 1-9 of Table 1. Throws std::invalid_argument if the start, its

@@ -27,7 +27,8 @@ struct GlobalPlannerServiceConfig {
   double replan_rate = 1.0;      // Hz (paper: 1 s)
   double nav_max_age = 0.5;      // s; older NAV_STATE is stale
   double cuboids_max_age = 5.0;  // s; without fresher CUBOIDS no route is published
-  // Core settings not taken from the mission (clearance, max_accel, speed are).
+  // Core settings not taken from the mission (clearance, max_accel, speed
+  // and vertical_speed are).
   double merge_distance = 3.0;
   double ground_altitude = 0.0;
   double min_altitude = 6.096;
@@ -35,6 +36,10 @@ struct GlobalPlannerServiceConfig {
   double path_spacing = 2.0;
   double collision_tolerance = 0.05;
   int max_obstacles = 500;
+  /// Segments cost their flight time within the mission's speed and
+  /// vertical speed limits (GlobalPlannerConfig::vertical_speed); false:
+  /// their length, as in the paper's Eq. 9.
+  bool time_cost = true;
 };
 
 /// Reads a global_planner config; unknown fields are errors.

@@ -1,6 +1,6 @@
 #pragma once
-// The searches over a CuboidGraph (Eq. 9): best-first with the straight
-// distance to the goal as the (consistent) estimate, and a segment tested
+// The searches over a CuboidGraph (Eq. 9): best-first with the cost of the
+// straight way to the goal as the (consistent) estimate, and a segment tested
 // against the cuboids only when it is about to fix a node's cost, so the
 // result is that of dynamic programming over the graph evaluated in full
 // (GlobalPlanner::build_graph) while only a few segments are tested.
