@@ -190,6 +190,7 @@ bool AvoidanceSupervisor::check_route_for_pinch(Utime now, const Limits& limits,
 RecoveryDecision AvoidanceSupervisor::update_recovery(Utime now, const Leg& leg,
                                                       const Limits& limits, const NavInput& nav,
                                                       bool engaged, const ClearanceQuery& clearance,
+                                                      const SeenQuery& seen,
                                                       SupervisorDecision* d) {
   RecoveryInput in;
   in.time = to_seconds(now);
@@ -205,6 +206,9 @@ RecoveryDecision AvoidanceSupervisor::update_recovery(Utime now, const Leg& leg,
   in.route_points = &recovery_route_;
   in.leg = GuidanceFrame::from_leg(leg.from, leg.to);
   in.route_flyable = [&] { return !check_route_for_pinch(now, limits, in.leg, clearance, d); };
+  in.way_seen = [&](const Vec3& from, const Vec3& to) {
+    return way_seen(seen, from, to, settings_.commit.seen_resolution / 2);
+  };
   RecoveryDecision decision = recovery_.update(in);
   if (decision.changed) {
     d->log.push_back(warn(fmt::format("t={:.2f} s recovery: {}: {}", in.time,
@@ -299,7 +303,8 @@ SupervisorDecision& AvoidanceSupervisor::decide(SupervisorDecision& d, Utime now
       stopping_at_target_ && active.final && (position - active.to).norm() <= active.capture_radius;
   const bool engaged = switch_.update(t, conflict, cross_track_distance(leg, position),
                                       stopping_speed, at_last_waypoint);
-  const RecoveryDecision recovery = update_recovery(now, leg, limits, nav, engaged, clearance, &d);
+  const RecoveryDecision recovery =
+      update_recovery(now, leg, limits, nav, engaged, clearance, map.seen, &d);
   if (!engaged) {
     Publish publish = Publish::kStats;
     if (was_engaged) {
@@ -381,9 +386,8 @@ SupervisorDecision& AvoidanceSupervisor::decide(SupervisorDecision& d, Utime now
   // so the scanner looks all round at every altitude it passes.
   const bool climbing = recovery.phase == RecoveryPhase::kClimbing;
   const StepOutput out =
-      climbing
-          ? planner_.climb(in, -(settings_.optimizer.ground_altitude + recovery.climb_altitude))
-          : planner_.step(in);
+      climbing ? planner_.climb(in, -(settings_.optimizer.ground_altitude + recovery.climb_target))
+               : planner_.step(in);
   ++steps_;
   // A plan that moves off, not a stop, a stall or a hover in place: the
   // recovery counts the vehicle stuck without one.

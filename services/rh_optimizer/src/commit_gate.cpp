@@ -162,4 +162,15 @@ CommitCheck CommitGate::check(const BsplineTrajectory& plan, double elapsed,
   return out;
 }
 
+bool way_seen(const SeenQuery& seen, const Vec3& from, const Vec3& to, double spacing) {
+  if (!seen || !from.allFinite() || !to.allFinite() || !(spacing > 0)) return false;
+  const double length = (to - from).head<2>().norm();
+  const int steps = std::max(1, static_cast<int>(std::ceil(length / spacing)));
+  for (int k = 0; k <= steps; ++k) {
+    const Vec3 p = from + (to - from) * (static_cast<double>(k) / steps);
+    if (!seen(p.x(), p.y())) return false;
+  }
+  return true;
+}
+
 }  // namespace ofn::rh

@@ -145,6 +145,18 @@ bool DeadEndRecovery::take_route(const RecoveryInput& in) {
   why << "the route does not head along the leg from here: escaping along it, next to ("
       << point.x() << ", " << point.y() << ", " << point.z() << ") m, "
       << (point - in.position).norm() << " m away";
+  // The turn to face the leg is for the scanner: the way it goes into
+  // counts as obstacle until a beam has crossed it. A way already seen
+  // (all round after a look) needs no turn; the controller's heading turns
+  // towards the plan as it flies. Only from a hover: a leg is flown from
+  // rest to rest, and the turn's hover is what stops a climb or a leg.
+  if (settings_.skip_turn_when_seen && in.way_seen && in.velocity.norm() < settings_.hover_speed &&
+      in.way_seen(in.position, point)) {
+    why << "; its way is seen: flying it at once";
+    enter(RecoveryPhase::kEscaping, why.str());
+    decision_.escape_from = in.position;
+    return true;
+  }
   enter(RecoveryPhase::kTurning, why.str());
   return true;
 }
@@ -169,9 +181,12 @@ void DeadEndRecovery::climb_or_hold(const RecoveryInput& in, const std::string& 
   std::ostringstream text;
   text << why << ": climbing from " << in.altitude << " to " << altitude
        << " m to look over what the scanner saw from below";
+  if (settings_.climb_through && altitude < ceiling)
+    text << " (and on, while no route comes, to " << ceiling << " m)";
   begin_turn(in);  // the heading turns on the way up: counted from here
   enter(RecoveryPhase::kClimbing, text.str());
   decision_.climb_altitude = altitude;
+  decision_.climb_target = settings_.climb_through ? ceiling : altitude;
   climb_start_ = in.time;
 }
 
@@ -266,6 +281,24 @@ RecoveryDecision DeadEndRecovery::update(const RecoveryInput& in) {
           in.velocity.norm() < settings_.hover_speed;
       const double allowed =
           settings_.climb_step / std::max(in.max_vertical_speed, 1e-3) + settings_.climb_extra_time;
+      const bool passing = decision_.climb_target > decision_.climb_altitude &&
+                           in.altitude + settings_.climb_tolerance >= decision_.climb_altitude;
+      if (passing && turned_all_round) {
+        // Through a step with the look done on the way: a climb done (the
+        // looks count from none again), and on to the next step without a
+        // stop; the plan flown (to the ceiling) does not change.
+        attempts_ = 0;
+        const double next =
+            std::min(decision_.climb_altitude + settings_.climb_step, settings_.climb_ceiling);
+        std::ostringstream why;
+        why << "climbed past " << decision_.climb_altitude
+            << " m, the heading turned all round on the way and no route: on to " << next << " m";
+        begin_turn(in);
+        enter(RecoveryPhase::kClimbing, why.str());
+        decision_.climb_altitude = next;
+        climb_start_ = in.time;
+        break;
+      }
       if (reached) {
         attempts_ = 0;
         std::ostringstream why;

@@ -192,6 +192,8 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
     d.climb_ceiling = v.number_in("climb_ceiling", d.climb_ceiling, 0.0, 1e4);
     d.climb_tolerance = v.number_in("climb_tolerance", d.climb_tolerance, 0.05, 10.0);
     d.climb_extra_time = v.number_in("climb_extra_time", d.climb_extra_time, 0.0, 600.0);
+    d.climb_through = v.boolean("climb_through", d.climb_through);
+    d.skip_turn_when_seen = v.boolean("skip_turn_when_seen", d.skip_turn_when_seen);
     v.finish();
   }
   {

@@ -571,6 +571,113 @@ TEST(DeadEndRecovery, AClimbThatDoesNotProceedEndsInNoRoute) {
   EXPECT_EQ(r.run(allowed + 0.1).phase, RecoveryPhase::kNoRoute);
 }
 
+// With climb_through the climb is flown to the ceiling and passes each step
+// once the heading has turned all round: no hover, no wait at the step;
+// a step passed before the turn is done is passed when it is.
+TEST(DeadEndRecovery, AClimbThroughPassesEachStepOnceTheLookIsDone) {
+  RecoverySettings s = settings();
+  s.climb_step = 15.0;
+  s.climb_ceiling = 80.0;
+  s.climb_through = true;
+  RecoveryRun r(s);
+  r.run(4.1);
+  RecoveryDecision d = r.look_finds(RouteKind::kNoPath);
+  ASSERT_EQ(d.phase, RecoveryPhase::kClimbing) << r.last_reason;
+  EXPECT_NEAR(d.climb_altitude, 51.6, 1e-9);
+  EXPECT_NEAR(d.climb_target, 80.0, 1e-9);  // the plan flown goes to the ceiling
+  // Past the step at speed, the heading not yet all round: climbing on to
+  // the same step.
+  r.in.velocity = Vec3(0, 0, -1.2);
+  r.in.altitude = 52.0;
+  d = r.run(5.0, 0.5);
+  ASSERT_EQ(d.phase, RecoveryPhase::kClimbing);
+  EXPECT_NEAR(d.climb_altitude, 51.6, 1e-9);
+  // The turn completes: the next step, the looks counted from none, the
+  // ceiling still the target; no look, no hover.
+  d = r.run(2 * M_PI / 0.5 - 5.0 + 0.3, 0.5);
+  ASSERT_EQ(d.phase, RecoveryPhase::kClimbing) << r.last_reason;
+  EXPECT_NEAR(d.climb_altitude, 66.6, 1e-9);
+  EXPECT_NEAR(d.climb_target, 80.0, 1e-9);
+  EXPECT_EQ(r.recovery.attempts(), 0);
+  EXPECT_NE(r.last_reason.find("on to 66.6 m"), std::string::npos) << r.last_reason;
+  // A route made on the way is taken at once.
+  r.in.altitude = 60.0;
+  r.give_route(RouteKind::kForward, {r.in.position, Vec3(150, 0, -60.0)});
+  EXPECT_EQ(r.step().phase, RecoveryPhase::kTurning);
+}
+
+TEST(DeadEndRecovery, AClimbThroughEndsAtTheCeilingWithALook) {
+  RecoverySettings s = settings();
+  s.climb_step = 15.0;
+  s.climb_ceiling = 60.0;
+  s.climb_through = true;
+  RecoveryRun r(s);
+  r.run(4.1);
+  ASSERT_EQ(r.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kClimbing);
+  r.in.velocity = Vec3(0, 0, -1.2);
+  r.in.altitude = 52.0;
+  RecoveryDecision d = r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+  ASSERT_EQ(d.phase, RecoveryPhase::kClimbing);
+  EXPECT_NEAR(d.climb_altitude, 60.0, 1e-9);  // the last step is the ceiling
+  EXPECT_NEAR(d.climb_target, 60.0, 1e-9);
+  r.in.velocity = Vec3::Zero();
+  r.in.altitude = 59.8;
+  ASSERT_EQ(r.step().phase, RecoveryPhase::kLooking) << r.last_reason;
+  EXPECT_EQ(r.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kNoRoute);
+}
+
+// Without climb_through each climb is flown to its step and stops there.
+TEST(DeadEndRecovery, AClimbRestToRestFliesToItsStep) {
+  RecoveryRun r;
+  r.run(4.1);
+  const RecoveryDecision d = r.look_finds(RouteKind::kNoPath);
+  ASSERT_EQ(d.phase, RecoveryPhase::kClimbing);
+  EXPECT_NEAR(d.climb_target, d.climb_altitude, 1e-9);
+}
+
+// skip_turn_when_seen: from a hover, an escape leg whose way the scanner
+// has seen starts at once; one into unseen space, or any leg while the
+// vehicle still moves, waits for the turn to face it.
+TEST(DeadEndRecovery, AnEscapeWhoseWayIsSeenStartsWithoutTheTurn) {
+  for (const bool seen : {true, false}) {
+    RecoverySettings s = settings();
+    s.skip_turn_when_seen = true;
+    RecoveryRun r(s);
+    int asked = 0;
+    r.in.way_seen = [&](const Vec3& from, const Vec3& to) {
+      ++asked;
+      EXPECT_LT((from - r.in.position).norm(), 1e-9);
+      EXPECT_LT((to - Vec3(20, 0, -36.6)).norm(), 1e-9);  // the first corner
+      return seen;
+    };
+    r.run(4.1);
+    r.run(2 * M_PI / 0.5 + 0.3, 0.5);  // the look; the heading ends about north
+    r.give_route(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+    const RecoveryDecision d = r.run(3.1);
+    EXPECT_EQ(asked, 1);
+    ASSERT_EQ(d.phase, seen ? RecoveryPhase::kEscaping : RecoveryPhase::kTurning)
+        << "seen " << seen << ": " << r.last_reason;
+    if (seen) {
+      EXPECT_LT((d.escape_point - Vec3(20, 0, -36.6)).norm(), 1e-9);
+      EXPECT_LT((d.escape_from - r.in.position).norm(), 1e-9);
+      EXPECT_FALSE(d.escape_route.empty());
+    }
+  }
+  // Off (the default), or moving: the turn, whatever is seen.
+  for (const bool moving : {false, true}) {
+    RecoverySettings s = settings();
+    s.skip_turn_when_seen = moving;
+    RecoveryRun r(s);
+    r.in.way_seen = [](const Vec3&, const Vec3&) { return true; };
+    r.run(4.1);
+    r.run(2 * M_PI / 0.5 + 0.3, 0.5);
+    r.give_route(RouteKind::kBacktrack, route_out_of_the_u(r.in.position));
+    if (moving) r.in.velocity = Vec3(0.5, 0, 0);
+    r.run(3.1);
+    EXPECT_EQ(r.recovery.phase(), RecoveryPhase::kTurning) << "moving " << moving;
+  }
+}
+
 TEST(DeadEndRecovery, DisabledItNeverActs) {
   RecoverySettings s = settings();
   s.enabled = false;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "ofn/rh_optimizer/commit_gate.hpp"
 #include "ofn/rh_optimizer/occlusion.hpp"
 
 namespace ofn::rh {
@@ -91,6 +92,29 @@ TEST(VisibilityRecord, ABeamCountsOnlyAsFarAsItsReach) {
   near.add_beam(Vec3(0.5, 0.5, -30), Vec3(20.5, 0.5, -30), true, 30.0);
   EXPECT_TRUE(near.seen(18.5, 0.5));
   EXPECT_FALSE(near.seen(20.5, 0.5));
+}
+
+TEST(VisibilityRecord, AWayIsSeenOnlyWhenEveryCellOfItIs) {
+  VisibilityRecord record(1.0, 3.0);
+  VisibilityRecord& v = record;
+  // Level beams north along east 0.5 and east along north 10.5, to 20 m.
+  v.add_beam(Vec3(0.5, 0.5, -30), Vec3(20.5, 0.5, -30), false, 30.0);
+  v.add_beam(Vec3(10.5, 0.5, -30), Vec3(10.5, 20.5, -30), false, 30.0);
+  const SeenQuery seen = [&](double n, double e) { return record.seen(n, e); };
+  EXPECT_TRUE(way_seen(seen, Vec3(0.5, 0.5, -30), Vec3(19.5, 0.5, -30)));
+  // The altitude of the ends does not matter: the record is of cells.
+  EXPECT_TRUE(way_seen(seen, Vec3(0.5, 0.5, -30), Vec3(10.5, 0.5, -50)));
+  // Along the first beam, then on along the second: seen; diagonally across
+  // the unseen corner between them: not.
+  EXPECT_TRUE(way_seen(seen, Vec3(10.5, 0.5, -30), Vec3(10.5, 19.5, -30)));
+  EXPECT_FALSE(way_seen(seen, Vec3(0.5, 0.5, -30), Vec3(10.5, 19.5, -30)));
+  // Past the end of a beam: not.
+  EXPECT_FALSE(way_seen(seen, Vec3(0.5, 0.5, -30), Vec3(25.5, 0.5, -30)));
+  // A way of no length is its one cell; bad input is never seen.
+  EXPECT_TRUE(way_seen(seen, Vec3(5.5, 0.5, -30), Vec3(5.5, 0.5, -30)));
+  EXPECT_FALSE(way_seen(seen, Vec3(5.5, 0.5, -30), Vec3(NAN, 0.5, -30)));
+  EXPECT_FALSE(way_seen(seen, Vec3(5.5, 0.5, -30), Vec3(6.5, 0.5, -30), 0.0));
+  EXPECT_FALSE(way_seen(SeenQuery{}, Vec3(5.5, 0.5, -30), Vec3(5.5, 0.5, -30)));
 }
 
 /// Level beams at flight altitude (30 m) from the vehicle at (0, 0) to every

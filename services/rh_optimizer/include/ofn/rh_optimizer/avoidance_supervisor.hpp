@@ -221,7 +221,8 @@ class AvoidanceSupervisor {
                              const ClearanceQuery& clearance, SupervisorDecision* d);
   RecoveryDecision update_recovery(Utime now, const Leg& leg, const Limits& limits,
                                    const NavInput& nav, bool engaged,
-                                   const ClearanceQuery& clearance, SupervisorDecision* d);
+                                   const ClearanceQuery& clearance, const SeenQuery& seen,
+                                   SupervisorDecision* d);
   /// Forgets the planner's previous plan, the last published one and the
   /// engagement's stop and stall flags (a new mission, a hand-back).
   void restart_planning();

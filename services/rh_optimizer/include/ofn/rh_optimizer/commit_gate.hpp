@@ -36,6 +36,12 @@ namespace ofn::rh {
 /// flight altitude (VisibilityRecord::seen).
 using SeenQuery = std::function<bool(double north, double east)>;
 
+/// Whether every horizontal cell of the straight way from `from` to `to`
+/// (sampled every `spacing` m, both ends included) has been seen: the way
+/// an escape leg goes, which then needs no turn to face it first. False
+/// for an empty query, non-finite ends or a spacing that is not positive.
+bool way_seen(const SeenQuery& seen, const Vec3& from, const Vec3& to, double spacing = 0.5);
+
 struct CommitSettings {
   /// s of a plan that is committed: the controller flies it alone until its
   /// REF_TRAJ timeout (0.5 s), then flies its stop; the next steps (0.1 s

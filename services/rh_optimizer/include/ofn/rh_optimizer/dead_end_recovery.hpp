@@ -72,6 +72,18 @@ struct RecoverySettings {
   /// which it ends where it got to (a climb the commit gate refuses stays a
   /// hover).
   double climb_extra_time = 15.0;
+  /// A climb goes on past its altitude to the next climb_step without
+  /// stopping once its heading has turned all round (the look is done, and
+  /// a route made on the way is taken at once, as in any climb):
+  /// the caller flies one climb to the ceiling (climb_target()) instead of
+  /// a hover, a wait of route_wait and a new climb every climb_step. False:
+  /// each climb is flown rest to rest.
+  bool climb_through = false;
+  /// An escape leg whose way the scanner has already seen (the caller's
+  /// way_seen) starts at once, without first turning to face it: after a
+  /// look around, the first leg's way has been seen all round. Only from a
+  /// hover. False: every leg waits for the turn.
+  bool skip_turn_when_seen = false;
 };
 
 enum class RecoveryPhase { kIdle, kLooking, kTurning, kEscaping, kClimbing, kNoRoute };
@@ -111,6 +123,10 @@ struct RecoveryInput {
   /// global planner has just been told of (find_narrow_passage), so a
   /// newer route is waited for. Empty: every route can be flown.
   std::function<bool()> route_flyable;
+  /// Whether every cell of the straight way from `from` to `to` has been
+  /// crossed by a beam (VisibilityRecord::seen): an escape along it may
+  /// start without turning to face it (skip_turn_when_seen). Empty: never.
+  std::function<bool(const Vec3& from, const Vec3& to)> way_seen;
 };
 
 struct RecoveryDecision {
@@ -126,8 +142,11 @@ struct RecoveryDecision {
   // seen from above). A look turns to the right; a turn to face the way on
   // takes the shorter way (the one way round cost up to 12 s per escape leg).
   bool turn_left = false;
-  // While climbing: the altitude (m above the ground) to climb to.
+  // While climbing: the altitude (m above the ground) the climb counts to
+  // (its step), and the one to fly to: the step's, or with climb_through
+  // the ceiling (the climb then passes each step without stopping).
   double climb_altitude = 0;
+  double climb_target = 0;
 };
 
 /// Index of the first route point from which every further step heads
