@@ -314,17 +314,33 @@ def longest_first(courses, out):
     return sorted(courses, key=lambda c: -wall.get(c, 0.0))
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during run_all: `results` holds the runs that had finished
+    before it ({key: result}); the ones under way were cut short (their
+    processes got the same SIGINT) and the ones not begun never ran."""
+
+    def __init__(self, results):
+        super().__init__()
+        self.results = results
+
+
 def run_all(tasks, jobs, on_done=None):
     """Run callables [(key, fn)] N at a time; returns {key: result} and calls
-    on_done(key, result, finished_count) as each one ends."""
+    on_done(key, result, finished_count) as each one ends. On Ctrl-C the runs
+    not begun are dropped and Interrupted carries those that finished."""
     results = {}
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs))
+    try:
         futures = {pool.submit(fn): key for key, fn in tasks}
         for n, fut in enumerate(concurrent.futures.as_completed(futures), 1):
             key = futures[fut]
             results[key] = fut.result()
             if on_done:
                 on_done(key, results[key], n)
+    except KeyboardInterrupt:
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise Interrupted(dict(results)) from None
+    pool.shutdown(wait=True)
     return results
 
 

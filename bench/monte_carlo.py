@@ -15,7 +15,9 @@ seed, MIL-F-8785C turbulence; the baseline flies in calm air, so its time
 ratio is against a calm flight). Each field is flown in the
 lockstep runner, N at a time, and, when the build has ofn_baseline, given
 its time-optimal baseline. Writes OUT/report.md, OUT/results.json (every
-run), OUT/clearance.png, OUT/time_ratio.png, OUT/fields/field-SEED.yaml
+run), OUT/fields.jsonl (each field's record as it finishes, so a run cut
+short keeps what it flew; Ctrl-C stops it, reports the fields that had
+finished and exits 130), OUT/clearance.png, OUT/time_ratio.png, OUT/fields/field-SEED.yaml
 (dense-SEED.yaml with --dense, trap-SEED.yaml with --trap) and, for failed runs, a figure
 OUT/failure-figures/fig-seed-SEED.png.
 
@@ -34,7 +36,8 @@ the command for each failure.
 Exit code: fair fields, 1 when the success rate is below 99 % (the goal);
 dense and trap fields, 1 when any field fails (a failure outcome, a safe stop
 although the baseline finds a route, a clearance below 0.8 R_s or a limit
-exceeded); 2 for bad arguments. The report is written either way.
+exceeded); 2 for bad arguments; 130 after Ctrl-C. The report is written
+either way (after Ctrl-C, of the fields that had finished).
 """
 import json
 import math
@@ -315,6 +318,9 @@ def write_report(args, runs, ctx):
            KIND_FLAGS[args.kind] + random_field.weather_flags(args.wind, args.turbulence),
            os.path.relpath(ctx["template_path"], REPO), n, args.jobs),
         "- weather: %s" % weather_text(args),
+    ] + ([
+        "- **interrupted**: %d of the %d fields had finished; every figure below is of those"
+        % ctx["interrupted"]] if ctx.get("interrupted") else []) + [
         "- link: %s" % ("between hosts (deploy/processes.yaml), %g %% of the datagrams lost, "
                          "every message %g +- %g s late, drawn from each field's seed"
                          % (100 * args.link_loss, args.link_delay, args.link_jitter)
@@ -337,7 +343,8 @@ def write_report(args, runs, ctx):
            "baselines_available": have_baseline, "wall_s": ctx["wall_s"], "load_average": ctx["load"],
            "seed_base": args.seed_base, "seeds": args.seeds, "link_loss": args.link_loss,
            "link_delay": args.link_delay, "link_jitter": args.link_jitter, "wind_kt": args.wind,
-           "turbulence": args.turbulence}
+           "turbulence": args.turbulence, "interrupted": bool(ctx.get("interrupted")),
+           "seeds_flown": [r["seed"] for r in runs]}
     clear_known = [c for c in clear if c is not None]
     if args.judged:
         routed = [r for r in runs if r["route"] is True]
@@ -479,7 +486,9 @@ def build_parser():
                "\n"
                "Exit codes: fair fields, 1 when the success rate is below %.0f %%; dense and trap fields,\n"
                "1 when any field fails; 2 for bad arguments, a missing build or a missing\n"
-               "Python module (PyYAML, numpy, matplotlib).  The report is written either way."
+               "Python module (PyYAML, numpy, matplotlib); 130 after Ctrl-C.  The report is written\n"
+               "either way (after Ctrl-C, of the fields that had finished; OUT/fields.jsonl holds\n"
+               "each field's record as it finished)."
                % (100 * SUCCESS_GOAL))
     cr.add_bin_option(ap)
     ap.add_argument("--runs", type=int, default=None, metavar="N",
@@ -588,12 +597,33 @@ def main(argv=None):
     load_before = os.getloadavg()[0]
     progress = Progress(len(seeds))
     t0 = time.monotonic()
-    results = campaign.run_all([(s, (lambda s=s: fly_field(args, s, args.template))) for s in seeds],
-                               args.jobs, lambda s, r, n: progress.update(not r["failed"], r["outcome"]))
-    runs = [results[s] for s in seeds]
+    # Every field's record as it finishes, one JSON line each: a run cut
+    # short (Ctrl-C, a lost machine) keeps what it had flown.
+    flown_log = open(os.path.join(args.out, "fields.jsonl"), "w")
+
+    def done(seed, rec, n):
+        flown_log.write(json.dumps(rec) + "\n")
+        flown_log.flush()
+        progress.update(not rec["failed"], rec["outcome"])
+
+    interrupted = False
+    try:
+        results = campaign.run_all([(s, (lambda s=s: fly_field(args, s, args.template)))
+                                    for s in seeds], args.jobs, done)
+    except campaign.Interrupted as stop:
+        results, interrupted = stop.results, True
+        print("\nmonte_carlo: interrupted: %d of %d fields had finished; reporting those"
+              % (len(results), len(seeds)), file=sys.stderr, flush=True)
+    finally:
+        flown_log.close()
+    runs = [results[s] for s in seeds if s in results]
+    if not runs:
+        print("monte_carlo: interrupted before any field finished: no report", file=sys.stderr)
+        return 130
     ctx = {"date": campaign.now_text(), "machine": campaign.machine_info(), "commit": campaign.git_commit(),
            "template": template, "template_path": os.path.abspath(args.template),
-           "wall_s": time.monotonic() - t0, "load": (load_before, os.getloadavg()[0])}
+           "wall_s": time.monotonic() - t0, "load": (load_before, os.getloadavg()[0]),
+           "interrupted": (len(runs), len(seeds)) if interrupted else None}
     doc = write_report(args, runs, ctx)
     print("outcomes: %s" % ", ".join("%s %d" % (o, doc["outcomes"][o]) for o in OUTCOMES))
     if args.judged:
@@ -618,6 +648,8 @@ def main(argv=None):
                 r["display_unit"], cr.fmt(r["max_speed"], 2), r["display_unit"],
                 "; ".join((r.get("why") or []) + r["failures"] if args.judged else r["failures"])))
     print("report: %s" % os.path.join(args.out, "report.md"))
+    if interrupted:
+        return 130
     if args.judged:
         return 1 if doc["failed"] else 0
     return 0 if doc["success_rate"] >= SUCCESS_GOAL else 1
