@@ -76,6 +76,7 @@ bool matches(const std::string& pattern, const std::string& channel) {
 void signed_bytes(const std::string& channel, const uint8_t* payload, size_t payload_size,
                   const uint8_t* role_and_sequence, std::vector<uint8_t>& out) {
   out.clear();
+  out.reserve(sizeof(kDomainTag) + channel.size() + 1 + payload_size + kRoleBytes + kSequenceBytes);
   out.insert(out.end(), kDomainTag, kDomainTag + sizeof(kDomainTag));
   out.insert(out.end(), channel.begin(), channel.end());
   out.push_back(0);

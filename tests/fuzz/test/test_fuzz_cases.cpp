@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include <map>
 #include <memory>
 #include <set>
@@ -194,8 +196,11 @@ TEST(Fuzzer, TakesAMessageHeardOnTheBusAsItsSeedOnlyWhenValidAndNow) {
   // Not one stamped far from now, not an invalid one, not one too large.
   EXPECT_FALSE(
       fuzzer.offer_seed("NAV_STATE", heard.data(), heard.size(), kNow + 60000000, 5000000, 4096));
+  // A quiet NaN (big-endian 7f f8 00..) in the first double after the stamp.
   auto nan = heard;
-  for (int i = 0; i < 8; ++i) nan[24 + i] = i == 0 ? 0x7f : i == 1 ? 0xf8 : 0;
+  ASSERT_GE(nan.size(), 32u);
+  const uint8_t quiet_nan[8] = {0x7f, 0xf8, 0, 0, 0, 0, 0, 0};
+  std::memcpy(nan.data() + 24, quiet_nan, sizeof(quiet_nan));
   EXPECT_FALSE(fuzzer.offer_seed("NAV_STATE", nan.data(), nan.size(), kNow, 5000000, 4096));
   EXPECT_FALSE(fuzzer.offer_seed("NAV_STATE", heard.data(), heard.size(), kNow, 5000000, 64));
   EXPECT_FALSE(fuzzer.offer_seed("NOT_FUZZED", heard.data(), heard.size(), kNow, 5000000, 4096));
