@@ -17,6 +17,8 @@
 #include "ofn/common/validate/global_path.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/global_planner/global_planner_service.hpp"
+#include "config_files.hpp"
+#include "ofn/common/config.hpp"
 #include "service_test_bus.hpp"
 
 namespace ofn::planning {
@@ -253,6 +255,32 @@ TEST_F(GlobalPlannerServiceTest, AnOutAndBackRouteFollowsTheControllersLeg) {
   send(channels::kNavState, nav(bus_.now(), 60.0));
   advance_to(bus_.now() + 2 * kMicrosPerSecond);
   EXPECT_NEAR(paths_.back().points.back()[0], -30.48, 1e-9);
+}
+
+using testing_support::ConfigFiles;
+
+TEST_F(ConfigFiles, TheTimeCostIsOffByDefaultAndTakesTheMissionsVerticalSpeed) {
+  // Off: a segment costs its length (the paper's Eq. 9), whatever the mission.
+  mission_t m = mission();
+  m.limits.max_vertical_speed = 1.524;
+  auto defaults = YamlReader::empty("(defaults)");
+  const GlobalPlannerServiceConfig off = load_global_planner_config(defaults);
+  EXPECT_FALSE(off.time_cost);
+  EXPECT_EQ(planner_config_for(off, m).vertical_speed, 0.0);
+  // On: the mission's vertical speed limit bounds the climbs' time.
+  auto on_file = YamlReader::load_file(write("global_planner.yaml", "time_cost: true\n"));
+  const GlobalPlannerServiceConfig on = load_global_planner_config(on_file);
+  EXPECT_TRUE(on.time_cost);
+  EXPECT_DOUBLE_EQ(planner_config_for(on, m).vertical_speed, 1.524);
+  // Not a boolean: an error naming the file and the field.
+  const std::string bad = write("bad.yaml", "time_cost: 3\n");
+  auto bad_file = YamlReader::load_file(bad);
+  try {
+    load_global_planner_config(bad_file);
+    FAIL() << "loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NAMES(std::string(e.what()), bad, "time_cost");
+  }
 }
 
 }  // namespace

@@ -39,7 +39,7 @@ struct GlobalPlannerServiceConfig {
   /// Segments cost their flight time within the mission's speed and
   /// vertical speed limits (GlobalPlannerConfig::vertical_speed); false:
   /// their length, as in the paper's Eq. 9.
-  bool time_cost = true;
+  bool time_cost = false;
 };
 
 /// Reads a global_planner config; unknown fields are errors.
