@@ -10,15 +10,15 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "config_files.hpp"
 #include "ofn/common/channels.hpp"
 #include "ofn/common/clock.hpp"
+#include "ofn/common/config.hpp"
 #include "ofn/common/logging.hpp"
 #include "ofn/common/node.hpp"
 #include "ofn/common/validate/global_path.hpp"
 #include "ofn/control_status_t.hpp"
 #include "ofn/global_planner/global_planner_service.hpp"
-#include "config_files.hpp"
-#include "ofn/common/config.hpp"
 #include "service_test_bus.hpp"
 
 namespace ofn::planning {
