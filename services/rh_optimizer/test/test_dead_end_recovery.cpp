@@ -526,8 +526,11 @@ TEST(DeadEndRecovery, NoRouteAfterTheLookClimbsToLookAgainUpToTheCeiling) {
 // the way up has seen what a look at its altitude would show, and only the
 // route is waited for; one that did not turn needs the look.
 TEST(DeadEndRecovery, AClimbThatTurnedAllRoundNeedsNoLookAfterIt) {
+  // Rest to rest: the climb stops at its step (climb_through passes it).
+  RecoverySettings s = settings();
+  s.climb_through = false;
   for (const bool turning : {true, false}) {
-    RecoveryRun r;
+    RecoveryRun r(s);
     r.run(4.1);
     ASSERT_EQ(r.look_finds(RouteKind::kNoPath).phase, RecoveryPhase::kClimbing);
     r.in.velocity = Vec3(0, 0, -1.2);
@@ -628,7 +631,9 @@ TEST(DeadEndRecovery, AClimbThroughEndsAtTheCeilingWithALook) {
 
 // Without climb_through each climb is flown to its step and stops there.
 TEST(DeadEndRecovery, AClimbRestToRestFliesToItsStep) {
-  RecoveryRun r;
+  RecoverySettings s = settings();
+  s.climb_through = false;
+  RecoveryRun r(s);
   r.run(4.1);
   const RecoveryDecision d = r.look_finds(RouteKind::kNoPath);
   ASSERT_EQ(d.phase, RecoveryPhase::kClimbing);
