@@ -78,12 +78,12 @@ struct RecoverySettings {
   /// the caller flies one climb to the ceiling (climb_target()) instead of
   /// a hover, a wait of route_wait and a new climb every climb_step. False:
   /// each climb is flown rest to rest.
-  bool climb_through = true;
+  bool climb_through = false;
   /// An escape leg whose way the scanner has already seen (the caller's
   /// way_seen) starts at once, without first turning to face it: after a
   /// look around, the first leg's way has been seen all round. Only from a
   /// hover. False: every leg waits for the turn.
-  bool skip_turn_when_seen = true;
+  bool skip_turn_when_seen = false;
 };
 
 enum class RecoveryPhase { kIdle, kLooking, kTurning, kEscaping, kClimbing, kNoRoute };
