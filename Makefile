@@ -43,8 +43,13 @@ deps:
 test-deps:
 	$(call install_missing,$(DEBIAN_PACKAGES) $(TEST_PACKAGES))
 
+# Optimised as flown, with line tables only (-g1): a backtrace names every
+# function, file and line, and the build is a third shorter than with full
+# debug information (docs/TESTING.md). For gdb's local variables, configure
+# a folder of your own with -DCMAKE_BUILD_TYPE=RelWithDebInfo or Debug.
 $(BUILD)/CMakeCache.txt:
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG"
 
 build: $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
