@@ -78,7 +78,7 @@ struct RecoverySettings {
   /// the caller flies one climb to the ceiling (climb_target()) instead of
   /// a hover, a wait of route_wait and a new climb every climb_step. False:
   /// each climb is flown rest to rest.
-  bool climb_through = false;
+  bool climb_through = true;
   /// An escape leg whose way the scanner has already seen (the caller's
   /// way_seen) starts at once, without first turning to face it: after a
   /// look around, the first leg's way has been seen all round. Only from a
