@@ -28,8 +28,9 @@ Progress is printed per row. Exit code 1 when any row's outcome is failure,
 (`make faults` installs it).
 
 Delay, jitter, duplication and reordering between hosts are not in the
-suite: this kernel has no sch_netem, and they need a userspace NFQUEUE
-program that the project does not have yet (docs/LIMITATIONS.md).
+suite: this kernel has neither sch_netem nor nftables' queue statement, so
+they would need a user-space relay between the host namespaces, which the
+project does not have (docs/TESTING.md#the-fault-suite).
 """
 import datetime
 import json
