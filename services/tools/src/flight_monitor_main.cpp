@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
               node.reject(ofn::heartbeat_channel(service), "names another service");
               return;
             }
-            if (heartbeats) heartbeats->heard(service, wall_seconds());
+            if (heartbeats) heartbeats->heard(service, m.service, wall_seconds());
             loss.heard(m);
           },
           ofn::SubscribeOptions{0.0, 0.0});

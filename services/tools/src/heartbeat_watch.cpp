@@ -14,6 +14,12 @@ void HeartbeatWatch::heard(const std::string& service, double now) {
   services_[service].last = now;
 }
 
+bool HeartbeatWatch::heard(const std::string& service, const std::string& named, double now) {
+  if (named != service) return false;
+  heard(service, now);
+  return true;
+}
+
 HeartbeatChanges HeartbeatWatch::check(double now) {
   HeartbeatChanges changes;
   for (auto& [name, entry] : services_) {

@@ -53,6 +53,14 @@ TEST(HeartbeatWatch, AServiceNeverHeardIsNotReported) {
   EXPECT_EQ(watch.silent(), Names{"mapper"});  // not the services never heard
 }
 
+TEST(HeartbeatWatch, AHeartbeatNamingAnotherServiceIsNoSignOfLife) {
+  HeartbeatWatch watch(3.0);
+  EXPECT_TRUE(watch.heard("rh_optimizer", "rh_optimizer", 0.0));
+  // A stranger's on the RH optimiser's channel, after it died at 0 s.
+  for (double t = 1; t <= 10; t += 1) EXPECT_FALSE(watch.heard("rh_optimizer", "fuzz", t));
+  EXPECT_EQ(watch.check(10.0).silent, Names{"rh_optimizer"});
+}
+
 TEST(HeartbeatWatch, TheSilenceMustBePositive) {
   EXPECT_THROW(HeartbeatWatch(0.0), std::invalid_argument);
   EXPECT_THROW(HeartbeatWatch(-1.0), std::invalid_argument);

@@ -25,11 +25,13 @@ class HeartbeatWatch {
   /// was heard counts as silent. Throws std::invalid_argument unless > 0.
   explicit HeartbeatWatch(double silence);
 
-  /// A heartbeat from `service` received at wall time `now`, s. The caller
-  /// has checked that the heartbeat names `service` itself: one on its
-  /// channel naming another service is a stranger's (such heartbeats kept a
-  /// dead RH optimiser "heard" under the bus fuzz) and is rejected before.
+  /// A heartbeat from `service` received at wall time `now`, s.
   void heard(const std::string& service, double now);
+  /// A heartbeat on `service`'s channel whose own service field says
+  /// `named`: a sign of life only when the two agree (one naming another
+  /// service is a stranger's, and kept a dead RH optimiser "heard" under
+  /// the bus fuzz). Returns whether it counted.
+  bool heard(const std::string& service, const std::string& named, double now);
   /// The changes since the last check, each list sorted by name. A service
   /// never heard is never reported.
   HeartbeatChanges check(double now);
