@@ -169,4 +169,24 @@ int extend_into_unseen(const mapping::Heightfield& mapped, mapping::Heightfield&
   return raised;
 }
 
+int raise_unseen_near(mapping::Heightfield& grid, const VisibilityRecord& visibility,
+                      const Vec3& vehicle, double exempt, double reach, float top) {
+  if (grid.empty() || !(reach > exempt) || !vehicle.allFinite()) return 0;
+  const int r_lo = std::max(0, grid.row_of(vehicle.x() - reach));
+  const int r_hi = std::min(grid.rows - 1, grid.row_of(vehicle.x() + reach));
+  const int c_lo = std::max(0, grid.col_of(vehicle.y() - reach));
+  const int c_hi = std::min(grid.cols - 1, grid.col_of(vehicle.y() + reach));
+  int raised = 0;
+  for (int r = r_lo; r <= r_hi; ++r)
+    for (int c = c_lo; c <= c_hi; ++c) {
+      const double north = grid.cell_centre_north(r), east = grid.cell_centre_east(c);
+      const double range = std::hypot(north - vehicle.x(), east - vehicle.y());
+      if (range < exempt || range > reach || !(grid.at(r, c) < top)) continue;
+      if (visibility.seen(north, east)) continue;
+      grid.at(r, c) = top;
+      ++raised;
+    }
+  return raised;
+}
+
 }  // namespace ofn::rh

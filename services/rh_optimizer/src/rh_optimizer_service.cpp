@@ -103,6 +103,10 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   c.occlusion_depth = r.number_in("occlusion_depth", c.occlusion_depth, 0.0, 500.0);
   c.visibility_band = r.number_in("visibility_band", c.visibility_band, 0.1, 100.0);
   c.unseen_extension = r.number_in("unseen_extension", c.unseen_extension, 0.0, 50.0);
+  c.unseen_near_reach = r.number_in("unseen_near_reach", c.unseen_near_reach, 0.0, 100.0);
+  c.unseen_near_exempt = r.number_in("unseen_near_exempt", c.unseen_near_exempt, 0.0, 100.0);
+  if (c.unseen_near_reach > 0 && !(c.unseen_near_exempt < c.unseen_near_reach))
+    r.fail("unseen_near_exempt", "expected less than unseen_near_reach (or unseen_near_reach 0)");
   c.planned_initial_acceleration =
       r.boolean("planned_initial_acceleration", c.planned_initial_acceleration);
   c.planned_initial_state = r.boolean("planned_initial_state", c.planned_initial_state);
@@ -426,6 +430,10 @@ MapView RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
       extend_into_unseen(mapped_, heightfield_, visibility_, vehicle, config_.unseen_extension,
                          1.0f, unknown_top);
     }
+    if (config_.unseen_near_reach > 0)
+      raise_unseen_near(heightfield_, visibility_, vehicle, config_.unseen_near_exempt,
+                        config_.unseen_near_reach,
+                        static_cast<float>(alt + config_.field_altitude_band));
   }
   const double lo = std::max(0.0, alt - config_.field_altitude_band);
   const double hi = std::max(lo + 1.0, alt + config_.field_altitude_band);

@@ -196,5 +196,46 @@ TEST(UnseenExtension, NothingWithoutReachOrBelowTheObstacleTop) {
   EXPECT_FLOAT_EQ(g.at(40, 47), 0.0f);
 }
 
+TEST(UnseenNear, UnseenCellsInTheRingBecomeObstacleSeenOnesDoNot) {
+  mapping::Heightfield g = face(0.0f);
+  // The vehicle at (20, 0); a beam along east = 0 to the north has seen
+  // that lane, nothing else has been looked at.
+  VisibilityRecord seen;
+  seen.add_beam(Vec3(20, 0, -30), Vec3(60, 0, -30), false, 30.0);
+  const Vec3 vehicle(20, 0, -30);
+  const int raised = raise_unseen_near(g, seen, vehicle, 4.0, 10.0, 70.0f);
+  EXPECT_GT(raised, 200);
+  int counted = 0;
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) {
+      const double range =
+          std::hypot(g.cell_centre_north(r) - vehicle.x(), g.cell_centre_east(c) - vehicle.y());
+      const bool looked = seen.seen(g.cell_centre_north(r), g.cell_centre_east(c));
+      const bool expect_raised = range >= 4.0 && range <= 10.0 && !looked;
+      EXPECT_FLOAT_EQ(g.at(r, c), expect_raised ? 70.0f : 0.0f) << "row " << r << " col " << c;
+      counted += expect_raised;
+    }
+  EXPECT_EQ(raised, counted);
+  // Beside the vehicle, inside the exempt radius: left alone; beyond the
+  // reach: left alone; on the seen lane: left alone.
+  EXPECT_FLOAT_EQ(g.at(g.row_of(20.5), g.col_of(2.5)), 0.0f);
+  EXPECT_FLOAT_EQ(g.at(g.row_of(20.5), g.col_of(15.5)), 0.0f);
+  EXPECT_FLOAT_EQ(g.at(g.row_of(27.5), g.col_of(0.5)), 0.0f);
+  EXPECT_FLOAT_EQ(g.at(g.row_of(27.5), g.col_of(6.5)), 70.0f);
+}
+
+TEST(UnseenNear, NothingWithoutARingAndNoCellLowered) {
+  mapping::Heightfield g = face(0.0f);
+  EXPECT_EQ(raise_unseen_near(g, VisibilityRecord(), Vec3(20, 0, -30), 10.0, 10.0, 70.0f), 0);
+  EXPECT_EQ(raise_unseen_near(g, VisibilityRecord(), Vec3(20, 0, -30), 4.0, 0.0, 70.0f), 0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(raise_unseen_near(g, VisibilityRecord(), Vec3(nan, 0, -30), 4.0, 10.0, 70.0f), 0);
+  // A mapped cell taller than the unknown top keeps its own height.
+  g.at(g.row_of(26.5), g.col_of(0.5)) = 90.0f;
+  raise_unseen_near(g, VisibilityRecord(), Vec3(20, 0, -30), 4.0, 10.0, 70.0f);
+  EXPECT_FLOAT_EQ(g.at(g.row_of(26.5), g.col_of(0.5)), 90.0f);
+  EXPECT_FLOAT_EQ(g.at(g.row_of(26.5), g.col_of(1.5)), 70.0f);
+}
+
 }  // namespace
 }  // namespace ofn::rh

@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
@@ -128,6 +131,24 @@ class RhOptimizerServiceTest : public ::testing::Test {
   std::vector<ref_traj_t> trajs_;
   std::vector<solver_stats_t> stats_;
 };
+
+TEST(RhOptimizerConfigReader, AnUnseenRingWhoseExemptDiscCoversItIsRefused) {
+  const std::string path = testing::TempDir() + "rh_unseen_ring.yaml";
+  auto load = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    auto reader = YamlReader::load_file(path);
+    return load_rh_optimizer_config(reader);
+  };
+  const auto good = load("unseen_near_reach: 10.0\nunseen_near_exempt: 4.0\n");
+  EXPECT_DOUBLE_EQ(good.unseen_near_reach, 10.0);
+  EXPECT_DOUBLE_EQ(good.unseen_near_exempt, 4.0);
+  // Off, the exempt radius is not compared with anything.
+  EXPECT_DOUBLE_EQ(load("unseen_near_reach: 0.0\nunseen_near_exempt: 8.0\n").unseen_near_exempt,
+                   8.0);
+  EXPECT_THROW(load("unseen_near_reach: 5.0\nunseen_near_exempt: 6.0\n"), ConfigError);
+  EXPECT_THROW(load("unseen_near_reach: 5.0\nunseen_near_exempt: 5.0\n"), ConfigError);
+  std::remove(path.c_str());
+}
 
 TEST_F(RhOptimizerServiceTest, ClearWayAheadLeavesNominalGuidanceAlone) {
   send(channels::kMission, mission());

@@ -114,4 +114,13 @@ int extend_into_unseen(const mapping::Heightfield& mapped, mapping::Heightfield&
                        const VisibilityRecord& visibility, const Vec3& vehicle_ned, double reach,
                        float min_top, float top);
 
+/// Every cell of `grid` lower than `top`, between `exempt` and `reach`
+/// metres horizontally from the vehicle, that no beam has crossed near
+/// flight altitude is raised to `top` (its height unknown). Nearer cells are
+/// left alone: at the start of a flight or of the sweep the scanner has
+/// looked along a narrow wedge only, and the vehicle itself stands in seen
+/// space. Returns the number of cells raised.
+int raise_unseen_near(mapping::Heightfield& grid, const VisibilityRecord& visibility,
+                      const Vec3& vehicle_ned, double exempt, double reach, float top);
+
 }  // namespace ofn::rh

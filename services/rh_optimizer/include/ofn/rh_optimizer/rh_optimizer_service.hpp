@@ -50,6 +50,18 @@ struct RhOptimizerServiceConfig {
   /// dense fields' clearance violation but cost completeness, forward-speed
   /// excursions and course time (docs/TUNING.md).
   double unseen_extension = 0.0;
+  /// Unseen cells from `unseen_near_exempt` to `unseen_near_reach` m of the
+  /// vehicle taken as obstacle of unknown height (raise_unseen_near; 0:
+  /// none; needs occlusion_depth > 0): beside the path, where the sweep
+  /// has not looked, the optimiser plans R_s + clearance_margin from them
+  /// and the commit gate's stops 0.9 R_s (dense seed 412 passed an unseen
+  /// cylinder at 0.78 R_s). The exempt disc keeps the vehicle's own
+  /// position outside them: its cell squares stay more than 0.5 R_s away,
+  /// where the optimiser still solves (start_inside_fraction). Off by
+  /// default: at 10 m every flight starts by braking to look round itself,
+  /// and the lockstep runner takes twice the CPU (docs/TUNING.md).
+  double unseen_near_reach = 0.0;
+  double unseen_near_exempt = 4.0;
   bool planned_initial_acceleration = true;  // a(t0) from the last plan, not the nav solution
   /// Position and velocity at t0 from the last plan too, while the vehicle
   /// is within these errors of it. Starting every plan at the measured
