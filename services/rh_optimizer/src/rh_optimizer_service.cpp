@@ -422,18 +422,17 @@ MapView RhOptimizerService::refresh_field(Utime now, const Vec3& vehicle) {
     cast_occlusion_shadows(heightfield_, visibility_, vehicle, alt, config_.occlusion_depth, 2.0,
                            &shadows_);
     shadows_.apply(heightfield_, visibility_);
-    // Beside what was mapped, what was not seen may be more of it, as tall
-    // as anything the field holds. Tops lower than 1 m are the ground (the
-    // mapper's ground_clearance), not obstacles to extend.
-    if (config_.unseen_extension > 0) {
-      const auto unknown_top = static_cast<float>(alt + config_.field_altitude_band);
+    // What was not seen is as tall as anything the field holds.
+    const auto unknown_top = static_cast<float>(alt + config_.field_altitude_band);
+    // Beside what was mapped, what was not seen may be more of it. Tops
+    // lower than 1 m are the ground (the mapper's ground_clearance), not
+    // obstacles to extend.
+    if (config_.unseen_extension > 0)
       extend_into_unseen(mapped_, heightfield_, visibility_, vehicle, config_.unseen_extension,
                          1.0f, unknown_top);
-    }
     if (config_.unseen_near_reach > 0)
       raise_unseen_near(heightfield_, visibility_, vehicle, config_.unseen_near_exempt,
-                        config_.unseen_near_reach,
-                        static_cast<float>(alt + config_.field_altitude_band));
+                        config_.unseen_near_reach, unknown_top);
   }
   const double lo = std::max(0.0, alt - config_.field_altitude_band);
   const double hi = std::max(lo + 1.0, alt + config_.field_altitude_band);
