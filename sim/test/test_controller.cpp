@@ -26,8 +26,8 @@ using vehicle::RotorcraftSimulation;
 
 constexpr double kControlDt = 0.01;    // 100 Hz control loop
 constexpr int kPhysicsPerControl = 4;  // 400 Hz physics
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaNInput = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInfInput = std::numeric_limits<double>::infinity();
 
 VehicleEstimate estimate_of(const vehicle::RotorcraftState& s) {
   VehicleEstimate x;
@@ -38,7 +38,7 @@ VehicleEstimate estimate_of(const vehicle::RotorcraftState& s) {
   return x;
 }
 
-bool within_limits(const Controls& c, const RotorcraftParams& p) {
+bool controls_within_limits(const Controls& c, const RotorcraftParams& p) {
   const auto v = c.as_array(), lo = p.min_controls.as_array(), hi = p.max_controls.as_array();
   for (int i = 0; i < 4; ++i)
     if (!std::isfinite(v[i]) || v[i] < lo[i] || v[i] > hi[i]) return false;
@@ -103,7 +103,8 @@ StepResponse fly_step(int axis, double size, double band, double duration) {
   for (int i = 0; i < steps; ++i) {
     const ControlOutput out = loop.step(ref);
     r.all_valid = r.all_valid && out.valid;
-    r.all_within_limits = r.all_within_limits && within_limits(out.controls, loop.model().params());
+    r.all_within_limits =
+        r.all_within_limits && controls_within_limits(out.controls, loop.model().params());
     const double t = (i + 1) * kControlDt;
     const Vec3& pos = loop.state().position;
     const double along = pos[axis] * (size > 0 ? 1.0 : -1.0);
@@ -371,10 +372,10 @@ TEST(TrajectoryController, NaNPositionGivesSafeFiniteControls) {
   TrajectoryController controller{RotorcraftParams{}};
   const RotorcraftParams p;
   VehicleEstimate x;
-  x.position = Vec3(kNaN, 0, 0);
+  x.position = Vec3(kNaNInput, 0, 0);
   const ControlOutput out = controller.step(Reference{}, x, kControlDt);
   EXPECT_FALSE(out.valid);
-  EXPECT_TRUE(within_limits(out.controls, p));
+  EXPECT_TRUE(controls_within_limits(out.controls, p));
   EXPECT_TRUE(out.commanded_accel.allFinite());
 }
 
@@ -382,10 +383,10 @@ TEST(TrajectoryController, InfiniteReferenceGivesSafeFiniteControls) {
   TrajectoryController controller{RotorcraftParams{}};
   const RotorcraftParams p;
   Reference ref;
-  ref.position = Vec3(kInf, 0, 0);
+  ref.position = Vec3(kInfInput, 0, 0);
   const ControlOutput out = controller.step(ref, VehicleEstimate{}, kControlDt);
   // Either replaced by the safe hover command, or a finite, limited command.
-  EXPECT_TRUE(within_limits(out.controls, p));
+  EXPECT_TRUE(controls_within_limits(out.controls, p));
   EXPECT_TRUE(out.commanded_accel.allFinite());
   if (!out.valid) {
     EXPECT_EQ(out.controls.as_array(), controller.hover_command().as_array());
@@ -405,21 +406,23 @@ TEST(TrajectoryController, GarbageInputsNeverGiveNonFiniteOrOutOfLimitControls) 
     modify(c.ref, c.x);
     cases.push_back(c);
   };
-  add("NaN position", [](Reference&, VehicleEstimate& x) { x.position.y() = kNaN; });
-  add("inf velocity", [](Reference&, VehicleEstimate& x) { x.velocity.x() = kInf; });
-  add("NaN attitude",
-      [](Reference&, VehicleEstimate& x) { x.attitude = Quat(kNaN, kNaN, kNaN, kNaN); });
-  add("NaN body rates", [](Reference&, VehicleEstimate& x) { x.body_rates.z() = kNaN; });
-  add("inf reference position", [](Reference& r, VehicleEstimate&) { r.position.z() = -kInf; });
-  add("NaN reference velocity", [](Reference& r, VehicleEstimate&) { r.velocity.x() = kNaN; });
+  add("NaN position", [](Reference&, VehicleEstimate& x) { x.position.y() = kNaNInput; });
+  add("inf velocity", [](Reference&, VehicleEstimate& x) { x.velocity.x() = kInfInput; });
+  add("NaN attitude", [](Reference&, VehicleEstimate& x) {
+    x.attitude = Quat(kNaNInput, kNaNInput, kNaNInput, kNaNInput);
+  });
+  add("NaN body rates", [](Reference&, VehicleEstimate& x) { x.body_rates.z() = kNaNInput; });
+  add("inf reference position",
+      [](Reference& r, VehicleEstimate&) { r.position.z() = -kInfInput; });
+  add("NaN reference velocity", [](Reference& r, VehicleEstimate&) { r.velocity.x() = kNaNInput; });
   add("inf reference acceleration",
-      [](Reference& r, VehicleEstimate&) { r.acceleration.y() = kInf; });
-  add("NaN yaw", [](Reference& r, VehicleEstimate&) { r.yaw = kNaN; });
-  add("inf yaw rate", [](Reference& r, VehicleEstimate&) { r.yaw_rate = kInf; });
+      [](Reference& r, VehicleEstimate&) { r.acceleration.y() = kInfInput; });
+  add("NaN yaw", [](Reference& r, VehicleEstimate&) { r.yaw = kNaNInput; });
+  add("inf yaw rate", [](Reference& r, VehicleEstimate&) { r.yaw_rate = kInfInput; });
   for (const auto& c : cases) {
     TrajectoryController controller{RotorcraftParams{}};
     const ControlOutput out = controller.step(c.ref, c.x, kControlDt);
-    EXPECT_TRUE(within_limits(out.controls, p)) << c.what;
+    EXPECT_TRUE(controls_within_limits(out.controls, p)) << c.what;
     EXPECT_TRUE(out.commanded_accel.allFinite()) << c.what;
     if (!out.valid) {
       // The safe command is the level hover.
@@ -433,8 +436,8 @@ TEST(TrajectoryController, RecoversAfterOneGarbageInput) {
   // afterwards give valid commands again.
   for (const VehicleEstimate& bad : [] {
          VehicleEstimate nan_position, nan_rates;
-         nan_position.position = Vec3(kNaN, kNaN, kNaN);
-         nan_rates.body_rates = Vec3(0, 0, kNaN);
+         nan_position.position = Vec3(kNaNInput, kNaNInput, kNaNInput);
+         nan_rates.body_rates = Vec3(0, 0, kNaNInput);
          return std::vector<VehicleEstimate>{nan_position, nan_rates};
        }()) {
     TrajectoryController controller{RotorcraftParams{}};
@@ -457,7 +460,7 @@ TEST(TrajectoryController, HugePositionErrorStaysWithinLimits) {
     for (int i = 0; i < 300; ++i) {
       const ControlOutput out = loop.step(ref);
       ASSERT_TRUE(out.valid) << error.transpose() << " step " << i;
-      ASSERT_TRUE(within_limits(out.controls, p)) << error.transpose() << " step " << i;
+      ASSERT_TRUE(controls_within_limits(out.controls, p)) << error.transpose() << " step " << i;
       // The pseudo-control stays within its bounds.
       ASSERT_LE(std::hypot(out.commanded_accel.x(), out.commanded_accel.y()),
                 g.max_horizontal_accel + 1e-9);

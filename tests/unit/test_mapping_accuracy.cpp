@@ -84,7 +84,7 @@ std::vector<Vec3> course_path(const std::string& name) {
   return {};
 }
 
-struct FlightResult {
+struct MappedFlight {
   std::vector<mapping::ObstacleEntry> obstacles;
   std::vector<Vec3> true_hits;  // noise-free obstacle hits of every beam the sensor got back
   mapping::MapperConfig config;
@@ -110,7 +110,7 @@ std::vector<ObstacleSpec> present_at(const std::vector<ObstacleSpec>& all, doubl
   return present;
 }
 
-FlightResult fly_and_map(const Scenario& scenario, const std::vector<Vec3>& path_ft,
+MappedFlight fly_and_map(const Scenario& scenario, const std::vector<Vec3>& path_ft,
                          const SensorFaults& faults = {}, const ScanHook& hook = {},
                          mapping::MapperConfig config = {}) {
   world::World world(scenario.obstacles, scenario.ground_altitude);
@@ -127,7 +127,7 @@ FlightResult fly_and_map(const Scenario& scenario, const std::vector<Vec3>& path
   config.occupancy.max_range = lidar.max_range();
   mapping::Mapper mapper(config);
 
-  FlightResult result;
+  MappedFlight result;
   result.config = config;
   const Utime period = lidar.period_us();
   const Utime nav_step = to_utime(0.01);
@@ -222,7 +222,7 @@ bool inside(const mapping::Cuboid& c, const Vec3& p, double tol) {
 }
 
 /// Every cuboid stands on or next to a real obstacle (none where none is).
-void expect_no_phantoms(const FlightResult& r, const world::World& world, double tol) {
+void expect_no_phantoms(const MappedFlight& r, const world::World& world, double tol) {
   for (const auto& e : r.obstacles) {
     double nearest = INFINITY;
     for (const auto& o : world.obstacles())
@@ -239,7 +239,7 @@ TEST_P(CourseMapping, CuboidsCoverTheObstaclesWithTheRightTopsAndNothingElse) {
   const Scenario scenario = load_scenario(scenario_path(name));
   ASSERT_FALSE(scenario.obstacles.empty());
   const world::World world(scenario.obstacles, scenario.ground_altitude);
-  const FlightResult r = fly_and_map(scenario, course_path(name));
+  const MappedFlight r = fly_and_map(scenario, course_path(name));
   ASSERT_GT(r.scans, 100);
   ASSERT_FALSE(r.true_hits.empty());
   ASSERT_FALSE(r.obstacles.empty());
@@ -288,7 +288,7 @@ TEST(MappingRobustness, OutliersAndDropoutsRaiseNoPhantomCuboid) {
     SensorFaults faults;
     faults.outlier_probability = 0.01;
     faults.dropout_probability = 0.05;
-    const FlightResult r = fly_and_map(scenario, course_path(name), faults);
+    const MappedFlight r = fly_and_map(scenario, course_path(name), faults);
     ASSERT_FALSE(r.obstacles.empty()) << name;
     expect_no_phantoms(r, world, r.config.grid.safety_margin + 2 * r.config.grid.resolution);
   }
@@ -303,7 +303,7 @@ TEST(MappingRobustness, SaturatedReturnsNeverRaiseAnObstacle) {
   for (const double probability : {0.5, 1.0}) {
     SensorFaults faults;
     faults.saturation_probability = probability;
-    const FlightResult r = fly_and_map(scenario, course_path("bench3"), faults);
+    const MappedFlight r = fly_and_map(scenario, course_path("bench3"), faults);
     ASSERT_FALSE(r.obstacles.empty());
     // Every top the mapper claims to have seen is the wall's. With half the
     // beams that pass over the wall saturated, the rest still show its top;
@@ -325,7 +325,7 @@ TEST(MappingRobustness, SaturatedReturnsNeverRaiseAnObstacle) {
   SensorFaults faults;
   faults.saturation_probability = 0.5;
   faults.ignore_status = true;
-  const FlightResult broken = fly_and_map(scenario, course_path("bench3"), faults);
+  const MappedFlight broken = fly_and_map(scenario, course_path("bench3"), faults);
   ASSERT_FALSE(broken.obstacles.empty());
   for (const auto& e : broken.obstacles)
     EXPECT_GT(e.cuboid.top_altitude(), wall_top + tol) << "cuboid " << e.id;

@@ -24,7 +24,7 @@
 namespace ofn {
 namespace {
 
-const std::string kOpenScenario = std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml";
+const std::string kOpenCourseFile = std::string(OFN_SOURCE_DIR) + "/sim/scenarios/open.yaml";
 
 vehicle::VehicleSimConfig sim_config() {
   auto reader = YamlReader::empty("(defaults)");
@@ -73,7 +73,7 @@ class VehicleSimFailsafe : public ::testing::Test {
 
 TEST_F(VehicleSimFailsafe, TheAirframesStabiliserFliesWhileCommandsStopAndHandsBack) {
   sim::Lockstep lockstep;
-  const Scenario open = load_scenario(kOpenScenario);
+  const Scenario open = load_scenario(kOpenCourseFile);
   vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), open, sim_config());
   const vehicle::Controls trim = vehicle.model().command();
   // Silent from 1 s to 7.05 s.
@@ -137,7 +137,7 @@ TEST_F(VehicleSimFailsafe, TheAirframesStabiliserFliesWhileCommandsStopAndHandsB
 
 TEST_F(VehicleSimFailsafe, CommandsThatFlowNeverWakeIt) {
   sim::Lockstep lockstep;
-  const Scenario open = load_scenario(kOpenScenario);
+  const Scenario open = load_scenario(kOpenCourseFile);
   vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), open, sim_config());
   FlightComputer computer(lockstep, vehicle.model().command(), [](double) { return true; });
   lockstep.add(vehicle.node());
@@ -156,7 +156,7 @@ TEST_F(VehicleSimFailsafe, OffAtZeroAndANegativeTimeoutIsNamed) {
     config.hold_until_engaged = false;
     config.lidar.enabled = false;
     sim::Lockstep lockstep;
-    const Scenario open = load_scenario(kOpenScenario);
+    const Scenario open = load_scenario(kOpenCourseFile);
     vehicle::VehicleSimService vehicle(lockstep.lcm(), lockstep.clock(), open, config);
     FlightComputer computer(lockstep, vehicle.model().command(), [](double t) { return t < 1.0; });
     lockstep.add(vehicle.node());

@@ -11,7 +11,7 @@
 namespace ofn {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNaNValue = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 nav_state_t good_nav() {
@@ -215,7 +215,7 @@ TEST(Validate, GoodMessagesOfEveryTypePass) {
 TEST(Validate, NavStateRejectsNonFinitePosition) {
   for (int i = 0; i < 3; ++i) {
     nav_state_t m = good_nav();
-    m.position[i] = kNaN;
+    m.position[i] = kNaNValue;
     EXPECT_NE(validate(m), "") << "axis " << i;
     m.position[i] = kInf;
     EXPECT_NE(validate(m), "") << "axis " << i;
@@ -230,19 +230,19 @@ TEST(Validate, NavStateRejectsFarAwayPosition) {
 
 TEST(Validate, NavStateRejectsNonFiniteVelocityAttitudeRates) {
   nav_state_t m = good_nav();
-  m.velocity[1] = kNaN;
+  m.velocity[1] = kNaNValue;
   EXPECT_NE(validate(m), "");
   m = good_nav();
   m.acceleration[2] = kInf;
   EXPECT_NE(validate(m), "");
   m = good_nav();
-  m.euler[0] = kNaN;
+  m.euler[0] = kNaNValue;
   EXPECT_NE(validate(m), "");
   m = good_nav();
-  m.body_rates[2] = kNaN;
+  m.body_rates[2] = kNaNValue;
   EXPECT_NE(validate(m), "");
   m = good_nav();
-  m.quaternion[3] = kNaN;
+  m.quaternion[3] = kNaNValue;
   EXPECT_NE(validate(m), "");
 }
 
@@ -270,7 +270,7 @@ TEST(Validate, NavStateRejectsUnnormalisedQuaternion) {
 
 TEST(Validate, ActuatorCommandRejectsNaNAndImplausibleAngles) {
   actuator_cmd_t m = good_cmd();
-  m.collective = kNaN;
+  m.collective = kNaNValue;
   EXPECT_NE(validate(m), "");
   m = good_cmd();
   m.pedal = kInf;
@@ -295,7 +295,7 @@ TEST(Validate, MissionRejectsZeroCaptureRadius) {
   mission_t m = good_mission();
   m.waypoints[1].capture_radius = 0.0;
   EXPECT_NE(validate(m), "");
-  m.waypoints[1].capture_radius = kNaN;
+  m.waypoints[1].capture_radius = kNaNValue;
   EXPECT_NE(validate(m), "");
 }
 
@@ -312,10 +312,10 @@ TEST(Validate, MissionRejectsBadLimitsAndWaypoints) {
   m.limits.max_accel = 0.0;
   EXPECT_NE(validate(m), "");
   m = good_mission();
-  m.limits.max_vertical_speed = kNaN;
+  m.limits.max_vertical_speed = kNaNValue;
   EXPECT_NE(validate(m), "");
   m = good_mission();
-  m.waypoints[0].position[1] = kNaN;
+  m.waypoints[0].position[1] = kNaNValue;
   EXPECT_NE(validate(m), "");
   m = good_mission();
   m.frame = "ENU";
@@ -424,7 +424,7 @@ TEST(Validate, RefTrajRejectsInconsistentSamples) {
   m.velocity.pop_back();
   EXPECT_NE(validate(m), "");
   m = good_traj();
-  m.position[1][0] = kNaN;
+  m.position[1][0] = kNaNValue;
   EXPECT_NE(validate(m), "");
   m = good_traj();
   m.num_samples = 2;
@@ -467,7 +467,7 @@ TEST(Validate, OtherTypesRejectTheirBadCases) {
   EXPECT_NE(validate(cl), "");
 
   global_path_t p = good_path();
-  p.points[1][2] = kNaN;
+  p.points[1][2] = kNaNValue;
   EXPECT_NE(validate(p), "");
 
   solver_stats_t s = good_stats();
@@ -482,7 +482,7 @@ TEST(Validate, OtherTypesRejectTheirBadCases) {
   EXPECT_NE(validate(s), "");
 
   control_status_t st = good_status();
-  st.position_error[0] = kNaN;
+  st.position_error[0] = kNaNValue;
   EXPECT_NE(validate(st), "");
 
   heartbeat_t h = good_heartbeat();
@@ -554,7 +554,7 @@ TEST(Validate, ObstacleGridGeometryIsTheMappers) {
 // passed with NaN or Inf in them (tests/fuzz).
 TEST(Validate, NonFiniteNumbersOutsideTheGeometryAreRejectedToo) {
   virtual_obstacles_t o = good_obstacles();
-  o.obstacles[0].appear_time = kNaN;
+  o.obstacles[0].appear_time = kNaNValue;
   EXPECT_EQ(validate(o), "obstacle schedule not finite");
   o = good_obstacles();
   o.obstacles[0].disappear_time = kInf;
@@ -564,7 +564,7 @@ TEST(Validate, NonFiniteNumbersOutsideTheGeometryAreRejectedToo) {
   EXPECT_EQ(validate(o), "");
 
   cuboid_list_t cl = good_cuboids();
-  cl.cuboids[0].confidence = kNaN;
+  cl.cuboids[0].confidence = kNaNValue;
   EXPECT_EQ(validate(cl), "cuboid confidence not finite");
 
   global_path_t p = good_path();
@@ -572,7 +572,7 @@ TEST(Validate, NonFiniteNumbersOutsideTheGeometryAreRejectedToo) {
   EXPECT_EQ(validate(p), "path cost not finite");
 
   control_status_t st = good_status();
-  st.yaw_reference = kNaN;
+  st.yaw_reference = kNaNValue;
   EXPECT_EQ(validate(st), "status not finite");
 
   for (double heartbeat_t::*field : {&heartbeat_t::loop_time_mean, &heartbeat_t::loop_time_max,

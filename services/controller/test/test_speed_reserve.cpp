@@ -11,7 +11,7 @@
 namespace ofn::control {
 namespace {
 
-constexpr double kDt = 0.01;
+constexpr double kStepPeriod = 0.01;
 constexpr double kMaxSpeed = 3.048;  // m/s, 10 ft/s
 
 /// Feeds `seconds` of a velocity error with the given RMS (Gaussian,
@@ -19,8 +19,8 @@ constexpr double kMaxSpeed = 3.048;  // m/s, 10 ft/s
 double reserve_after(SpeedReserve& r, double rms, double seconds, unsigned seed = 1) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, rms / std::sqrt(3.0));
-  for (int i = 0; i < static_cast<int>(seconds / kDt); ++i)
-    r.update(Vec3(noise(rng), noise(rng), noise(rng)), kDt);
+  for (int i = 0; i < static_cast<int>(seconds / kStepPeriod); ++i)
+    r.update(Vec3(noise(rng), noise(rng), noise(rng)), kStepPeriod);
   return r.reserve(kMaxSpeed);
 }
 
@@ -71,10 +71,10 @@ TEST(SpeedReserve, LearnsOfGustsOverItsTimeConstant) {
   // From calm: after 1 s of a 0.6 m/s error the mean square is a tenth of
   // its value (1 - e^-0.1), short of the onset; after 3 time constants
   // 95 % of it.
-  for (int i = 0; i < 100; ++i) r.update(Vec3(0.6, 0, 0), kDt);
+  for (int i = 0; i < 100; ++i) r.update(Vec3(0.6, 0, 0), kStepPeriod);
   EXPECT_NEAR(r.rms(), 0.6 * std::sqrt(1.0 - std::exp(-0.1)), 1e-3);
   EXPECT_EQ(r.reserve(kMaxSpeed), 0.0);
-  for (int i = 100; i < 3000; ++i) r.update(Vec3(0.6, 0, 0), kDt);
+  for (int i = 100; i < 3000; ++i) r.update(Vec3(0.6, 0, 0), kStepPeriod);
   EXPECT_NEAR(r.rms(), 0.6 * std::sqrt(1.0 - std::exp(-3.0)), 1e-3);
   EXPECT_NEAR(r.reserve(kMaxSpeed), r.settings().sigmas * r.rms(), 1e-9);
 }
@@ -83,7 +83,7 @@ TEST(SpeedReserve, NeverTakesMoreThanItsShareOfTheLimit) {
   SpeedReserveSettings s;
   s.max_fraction = 0.3;
   SpeedReserve r(s);
-  for (int i = 0; i < 5000; ++i) r.update(Vec3(5.0, 0, 0), kDt);
+  for (int i = 0; i < 5000; ++i) r.update(Vec3(5.0, 0, 0), kStepPeriod);
   EXPECT_NEAR(r.reserve(kMaxSpeed), 0.3 * kMaxSpeed, 1e-12);
   EXPECT_EQ(r.reserve(0.0), 0.0);  // no limit, nothing to keep back from
   EXPECT_EQ(r.reserve(-1.0), 0.0);
@@ -102,7 +102,7 @@ TEST(SpeedReserve, IgnoresBadInputAndCanBeTurnedOff) {
   reserve_after(r, 0.6, 60.0);
   const double before = r.rms();
   const double nan = std::nan("");
-  r.update(Vec3(nan, 0, 0), kDt);
+  r.update(Vec3(nan, 0, 0), kStepPeriod);
   r.update(Vec3(1, 0, 0), nan);
   r.update(Vec3(1, 0, 0), -1.0);
   r.update(Vec3(1, 0, 0), 0.0);

@@ -12,7 +12,7 @@
 namespace ofn::control {
 namespace {
 
-constexpr double kDt = 0.01;
+constexpr double kGuidancePeriod = 0.01;
 
 Limits limits(double max_speed, double max_accel, double max_vertical_speed) {
   Limits l;
@@ -38,10 +38,10 @@ struct PerfectFollower {
 
   /// Runs until done (or `max_seconds`); returns whether it arrived.
   bool run(double max_seconds) {
-    const int steps = static_cast<int>(max_seconds / kDt);
+    const int steps = static_cast<int>(max_seconds / kGuidancePeriod);
     for (int i = 0; i < steps; ++i) {
       positions.push_back(position);
-      const GuidanceReference r = guidance.update(position, velocity, kDt);
+      const GuidanceReference r = guidance.update(position, velocity, kGuidancePeriod);
       refs.push_back(r);
       position = r.position;
       velocity = r.velocity;
@@ -74,7 +74,7 @@ TEST(WaypointGuidance, FliesThePlannersLegAndMovesOnWithIt) {
   EXPECT_FALSE(f.guidance.follow_leg(3, true, f.position, f.velocity));   // no such waypoint
   EXPECT_FALSE(f.guidance.follow_leg(1, true, f.position, f.velocity));   // the same leg: a cap
   // Inside waypoint 1's capture radius guidance waits for the planner.
-  while (f.position.x() < 97.0 && f.refs.size() < 3000) ASSERT_FALSE(f.run(kDt));
+  while (f.position.x() < 97.0 && f.refs.size() < 3000) ASSERT_FALSE(f.run(kGuidancePeriod));
   ASSERT_GE(f.position.x(), 97.0);
   ASSERT_FALSE(f.run(0.1));
   EXPECT_EQ(f.refs.back().active_waypoint, 1);
@@ -82,7 +82,7 @@ TEST(WaypointGuidance, FliesThePlannersLegAndMovesOnWithIt) {
   // The planner moves on: on from where the reference is, no jump.
   EXPECT_TRUE(f.guidance.follow_leg(2, true, f.position, f.velocity));
   EXPECT_EQ(f.guidance.active_waypoint(), 2);
-  const GuidanceReference next = f.guidance.update(f.position, f.velocity, kDt);
+  const GuidanceReference next = f.guidance.update(f.position, f.velocity, kGuidancePeriod);
   EXPECT_EQ(next.active_waypoint, 2);
   EXPECT_LT((next.position - before).norm(), 0.2);
   EXPECT_FALSE(f.guidance.follow_leg(1, true, f.position, f.velocity));  // never back
@@ -97,10 +97,10 @@ TEST(WaypointGuidance, APlannerFurtherOnWhilePlansAreFlownGivesTheTrueLeg) {
       {Vec3(0, 0, -30), 5.0}, {Vec3(100, 0, -30), 5.0}, {Vec3(0, 0, -30), 5.0}};
   WaypointGuidance g;
   g.set_mission(wps, 10.0, limits(10, 2, 3), Vec3(0, 0, -30), Vec3::Zero());
-  g.update(Vec3(0, 0, -30), Vec3::Zero(), kDt);
+  g.update(Vec3(0, 0, -30), Vec3::Zero(), kGuidancePeriod);
   const Vec3 vehicle(30, 2, -30);
   ASSERT_TRUE(g.follow_leg(2, false, vehicle, Vec3(-3, 0, 0)));
-  const GuidanceReference r = g.update(vehicle, Vec3(-3, 0, 0), kDt);
+  const GuidanceReference r = g.update(vehicle, Vec3(-3, 0, 0), kGuidancePeriod);
   EXPECT_EQ(r.active_waypoint, 2);
   EXPECT_TRUE(r.position.isApprox(vehicle, 1e-9));
   const Vec3 rejoin = (Vec3(30 - kGuidanceRejoinDistance, 0, -30) - vehicle).normalized();
@@ -111,7 +111,7 @@ TEST(WaypointGuidance, APlannerFurtherOnWhilePlansAreFlownGivesTheTrueLeg) {
 TEST(WaypointGuidance, WithoutMissionGivesNoWaypoint) {
   WaypointGuidance g;
   EXPECT_FALSE(g.has_mission());
-  const GuidanceReference r = g.update(Vec3(1, 2, 3), Vec3::Zero(), kDt);
+  const GuidanceReference r = g.update(Vec3(1, 2, 3), Vec3::Zero(), kGuidancePeriod);
   EXPECT_EQ(r.active_waypoint, -1);
   EXPECT_FALSE(r.done);
 }
@@ -154,8 +154,8 @@ TEST(WaypointGuidance, StraightLegRespectsSpeedAndAccelerationLimitsAndStopsAtTh
     }
   }
   // A flight of 100 m at 3 m/s with gentle ramps: well under a minute.
-  EXPECT_LT(f.refs.size() * kDt, 60.0);
-  EXPECT_GT(f.refs.size() * kDt, 100.0 / cruise);
+  EXPECT_LT(f.refs.size() * kGuidancePeriod, 60.0);
+  EXPECT_GT(f.refs.size() * kGuidancePeriod, 100.0 / cruise);
 }
 
 TEST(WaypointGuidance, ASpeedReserveLowersTheCruiseWithoutASpeedStep) {
@@ -188,7 +188,7 @@ TEST(WaypointGuidance, StaysDoneAndStillAtTheLastWaypoint) {
   PerfectFollower f(wps, 3.0, limits(3.0, 0.5, 1.0), wps[0].position);
   ASSERT_TRUE(f.run(60.0));
   for (int i = 0; i < 500; ++i) {
-    const GuidanceReference r = f.guidance.update(f.position, f.velocity, kDt);
+    const GuidanceReference r = f.guidance.update(f.position, f.velocity, kGuidancePeriod);
     EXPECT_TRUE(r.done);
     EXPECT_LE(r.position.x(), 20.0 + 1e-9);
     EXPECT_LE(r.velocity.norm(), 1e-9);
@@ -240,7 +240,7 @@ TEST(WaypointGuidance, RestartMidLegPicksUpTheLegTheVehicleIsOn) {
   const Vec3 position(50.4, 24.0, -30.2);  // near the middle of leg 2
   const Vec3 velocity(0.0, 3.0, 0.0);
   g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), position, velocity);
-  const GuidanceReference r = g.update(position, velocity, kDt);
+  const GuidanceReference r = g.update(position, velocity, kGuidancePeriod);
   EXPECT_EQ(r.active_waypoint, 2);
   // No jump: the reference starts on the vehicle, not a step ahead of it
   // nor on the leg beside it, moving at the vehicle's speed along the
@@ -258,15 +258,16 @@ TEST(WaypointGuidance, ResyncStartsOnTheVehicleThenAdvances) {
   const std::vector<Waypoint> wps = {{Vec3(0, 0, -30), 2.0}, {Vec3(200, 0, -30), 2.0}};
   WaypointGuidance g;
   g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), wps[0].position, Vec3::Zero());
-  for (int i = 0; i < 100; ++i) g.update(wps[0].position, Vec3::Zero(), kDt);
+  for (int i = 0; i < 100; ++i) g.update(wps[0].position, Vec3::Zero(), kGuidancePeriod);
   const Vec3 position(80, 0, -30), velocity(2.5, 0, 0);  // below the cruise
   g.resync(position, velocity);
-  const GuidanceReference first = g.update(position, velocity, kDt);
+  const GuidanceReference first = g.update(position, velocity, kGuidancePeriod);
   EXPECT_LT((first.position - position).norm(), 1e-9);
   EXPECT_NEAR(first.velocity.x(), 2.5, 1e-9);
-  const GuidanceReference second = g.update(position + velocity * kDt, velocity, kDt);
-  EXPECT_GT(second.position.x(), 80 + 2.5 * kDt);  // on, speeding up toward the cruise
-  EXPECT_LT(second.position.x(), 80 + 3.0 * kDt);
+  const GuidanceReference second =
+      g.update(position + velocity * kGuidancePeriod, velocity, kGuidancePeriod);
+  EXPECT_GT(second.position.x(), 80 + 2.5 * kGuidancePeriod);  // on, speeding up toward the cruise
+  EXPECT_LT(second.position.x(), 80 + 3.0 * kGuidancePeriod);
 }
 
 TEST(WaypointGuidance, OffTheLegItRejoinsAlongTheCheckedSegmentWithoutAJump) {
@@ -284,7 +285,7 @@ TEST(WaypointGuidance, OffTheLegItRejoinsAlongTheCheckedSegmentWithoutAJump) {
   for (size_t i = 0; i < f.refs.size(); ++i) {
     const Vec3& p = f.refs[i].position;
     if (i > 0) {
-      EXPECT_LE((p - f.refs[i - 1].position).norm(), 3.0 * kDt + 1e-9) << i;
+      EXPECT_LE((p - f.refs[i - 1].position).norm(), 3.0 * kGuidancePeriod + 1e-9) << i;
     }
     if (p.x() < meet.x() - 1e-9) {
       EXPECT_LT(distance_to_segment(p, start, meet), 1e-9) << p.transpose();
@@ -314,7 +315,7 @@ TEST(WaypointGuidance, RestartNearTheFirstLegStartsThere) {
       {Vec3(0, 0, -30), 5.0}, {Vec3(50, 0, -30), 5.0}, {Vec3(50, 50, -30), 5.0}};
   WaypointGuidance g;
   g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), Vec3(20, 1, -30), Vec3::Zero());
-  EXPECT_EQ(g.update(Vec3(20, 1, -30), Vec3::Zero(), kDt).active_waypoint, 1);
+  EXPECT_EQ(g.update(Vec3(20, 1, -30), Vec3::Zero(), kGuidancePeriod).active_waypoint, 1);
 }
 
 TEST(WaypointGuidance, VerticalLegRespectsMaxVerticalSpeed) {
@@ -360,9 +361,9 @@ TEST(WaypointGuidance, ReferenceWaitsForALaggingVehicle) {
   g.set_mission(wps, 3.0, limits(3.0, 0.5, 1.0), stuck, Vec3::Zero());
   const double max_accel = 0.5, cruise = 3.0;
   GuidanceReference r;
-  for (int i = 0; i < 3000; ++i) r = g.update(stuck, Vec3::Zero(), kDt);
+  for (int i = 0; i < 3000; ++i) r = g.update(stuck, Vec3::Zero(), kGuidancePeriod);
   const double after_30s = r.position.x();
-  for (int i = 0; i < 3000; ++i) r = g.update(stuck, Vec3::Zero(), kDt);
+  for (int i = 0; i < 3000; ++i) r = g.update(stuck, Vec3::Zero(), kGuidancePeriod);
   // The rubber band asks for zero speed two leads ahead; past that the
   // reference can only coast through its braking distance.
   const double braking = cruise * cruise / (2.0 * config.accel_fraction * max_accel);
@@ -380,7 +381,7 @@ TEST(WaypointGuidance, ClearRemovesTheMission) {
   EXPECT_TRUE(g.has_mission());
   g.clear();
   EXPECT_FALSE(g.has_mission());
-  EXPECT_EQ(g.update(Vec3::Zero(), Vec3::Zero(), kDt).active_waypoint, -1);
+  EXPECT_EQ(g.update(Vec3::Zero(), Vec3::Zero(), kGuidancePeriod).active_waypoint, -1);
 }
 
 }  // namespace

@@ -20,8 +20,8 @@
 namespace ofn::planning {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kAltitude = 36.6;  // m
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr double kFlightAltitude = 36.6;  // m
 
 ObstacleBox cuboid(int id, Vec3 min_corner, Vec3 max_corner, bool top_observed = true) {
   ObstacleBox b;
@@ -34,9 +34,9 @@ ObstacleBox cuboid(int id, Vec3 min_corner, Vec3 max_corner, bool top_observed =
 
 PlanRequest request_along_north(std::vector<ObstacleBox> obstacles) {
   PlanRequest r;
-  r.start = Vec3(0.0, 0.0, -kAltitude);
+  r.start = Vec3(0.0, 0.0, -kFlightAltitude);
   r.leg_from = r.start;
-  r.goal = Vec3(100.0, 0.0, -kAltitude);
+  r.goal = Vec3(100.0, 0.0, -kFlightAltitude);
   r.obstacles = std::move(obstacles);
   return r;
 }
@@ -134,8 +134,8 @@ TEST(CuboidGraph, NodesSitAtTheClearanceRoundAndOnTopOfOneCuboid) {
   EXPECT_EQ(graph.goal_holder(), -1);
   EXPECT_EQ(graph.ignored(), 0);
   const auto& nodes = graph.nodes();
-  EXPECT_TRUE(nodes[0].isApprox(Vec3(0, 0, -kAltitude)));
-  EXPECT_TRUE(nodes[1].isApprox(Vec3(100, 0, -kAltitude)));
+  EXPECT_TRUE(nodes[0].isApprox(Vec3(0, 0, -kFlightAltitude)));
+  EXPECT_TRUE(nodes[1].isApprox(Vec3(100, 0, -kFlightAltitude)));
   // Four corners at the leg's altitude, four on top, two where the leg
   // crosses the footprint on top.
   ASSERT_EQ(graph.size(), 12);
@@ -145,7 +145,7 @@ TEST(CuboidGraph, NodesSitAtTheClearanceRoundAndOnTopOfOneCuboid) {
     EXPECT_TRUE(std::abs(p.x() - (40 - rs)) < 1e-9 || std::abs(p.x() - (50 + rs)) < 1e-9 ||
                 std::abs(p.y()) < 1e-9)
         << p.transpose();
-    if (std::abs(p.z() + kAltitude) < 1e-9) ++at_altitude;
+    if (std::abs(p.z() + kFlightAltitude) < 1e-9) ++at_altitude;
     if (std::abs(p.z() - (-20 - rs)) < 1e-9) ++on_top;
     EXPECT_DOUBLE_EQ(graph.along(i), p.x());
   }
@@ -200,7 +200,7 @@ TEST(CuboidGraph, AStartInsideTheClearanceMayLeaveButNotCrossTheCuboid) {
   GlobalPlannerConfig config;
   const ObstacleBox box = cuboid(3, Vec3(10, -4, -60), Vec3(20, 4, 0));
   PlanRequest request = request_along_north({box});
-  request.start = Vec3(8.0, 10.0, -kAltitude);  // 2 m from the box, within R_s
+  request.start = Vec3(8.0, 10.0, -kFlightAltitude);  // 2 m from the box, within R_s
   request.leg_from = request.start;
   CuboidGraph graph(config, request);
   EXPECT_EQ(graph.start_holder(), -1);  // not inside the box itself
@@ -218,7 +218,7 @@ TEST(CuboidGraph, AStartInsideTheClearanceMayLeaveButNotCrossTheCuboid) {
 // Dijkstra over every segment the graph's blocked() allows, any direction.
 double dijkstra_any_direction(CuboidGraph& graph) {
   return test::dijkstra(graph.size(), [&](int u, int v) {
-    return v == 0 || v == u || graph.blocked(u, v) ? kInf : graph.cost(u, v);
+    return v == 0 || v == u || graph.blocked(u, v) ? kInfinity : graph.cost(u, v);
   });
 }
 
@@ -274,7 +274,7 @@ void expect_any_direction_optimal(double vertical_speed) {
         c += any_graph.cost(sequence[k - 1], sequence[k]);
       return c;
     };
-    if (reference == kInf) {
+    if (reference == kInfinity) {
       EXPECT_TRUE(any.empty());
       EXPECT_TRUE(forward.empty());
       continue;

@@ -16,7 +16,7 @@
 namespace ofn::mapping {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNaNCoordinate = std::numeric_limits<double>::quiet_NaN();
 
 OccupancyMapConfig unit_config() {
   OccupancyMapConfig c;
@@ -26,7 +26,7 @@ OccupancyMapConfig unit_config() {
 }
 
 // A point (NED) at the given altitude above flat ground at 0.
-Vec3 at_altitude(double north, double east, double altitude) {
+Vec3 point_at_altitude(double north, double east, double altitude) {
   return Vec3(north, east, -altitude);
 }
 
@@ -87,22 +87,22 @@ Scan scan_of(const Vec3& sensor, const Wall& wall, double max_range, double elev
 
 TEST(OccupancyMap, HitsBecomeOccupiedAndTheBeamFree) {
   OccupancyMap map(unit_config());
-  const Vec3 sensor = at_altitude(0.5, 0.5, 10.5);
-  const Vec3 hit = at_altitude(20.5, 0.5, 10.5);
+  const Vec3 sensor = point_at_altitude(0.5, 0.5, 10.5);
+  const Vec3 hit = point_at_altitude(20.5, 0.5, 10.5);
   map.insert_scan(sensor, {hit}, {});
   EXPECT_EQ(voxel_at(map, hit), Voxel::kOccupied);
-  EXPECT_EQ(voxel_at(map, at_altitude(10.5, 0.5, 10.5)), Voxel::kFree);
-  EXPECT_EQ(voxel_at(map, at_altitude(21.5, 0.5, 10.5)), Voxel::kUnknown);
-  EXPECT_EQ(voxel_at(map, at_altitude(10.5, 5.5, 10.5)), Voxel::kUnknown);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(10.5, 0.5, 10.5)), Voxel::kFree);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(21.5, 0.5, 10.5)), Voxel::kUnknown);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(10.5, 5.5, 10.5)), Voxel::kUnknown);
   EXPECT_GT(map.num_nodes(), 0u);
   EXPECT_GT(map.memory_bytes(), 0u);
 }
 
 TEST(OccupancyMap, FalseReturnFadesWhileARepeatedWallStays) {
   OccupancyMap map(unit_config());
-  const Vec3 sensor = at_altitude(0.5, 0.5, 10.5);
-  const Vec3 false_return = at_altitude(10.5, 0.5, 10.5);
-  const Vec3 wall = at_altitude(30.5, 0.5, 10.5);
+  const Vec3 sensor = point_at_altitude(0.5, 0.5, 10.5);
+  const Vec3 false_return = point_at_altitude(10.5, 0.5, 10.5);
+  const Vec3 wall = point_at_altitude(30.5, 0.5, 10.5);
   map.insert_scan(sensor, {false_return, wall}, {});
   ASSERT_EQ(voxel_at(map, false_return), Voxel::kOccupied);
   EXPECT_GT(map.column_top(10.5, 0.5, 0.5, 1.0, 30.0), 0.0);
@@ -120,52 +120,54 @@ TEST(OccupancyMap, FalseReturnFadesWhileARepeatedWallStays) {
 
 TEST(OccupancyMap, ManyBeamsIntoOneVoxelCountOncePerScan) {
   OccupancyMap map(unit_config());
-  const Vec3 sensor = at_altitude(0.5, 0.5, 10.5);
-  const Vec3 false_return = at_altitude(10.5, 0.5, 10.5);
+  const Vec3 sensor = point_at_altitude(0.5, 0.5, 10.5);
+  const Vec3 false_return = point_at_altitude(10.5, 0.5, 10.5);
   // Forty returns in one voxel in one scan are one observation: two scans
   // of a single beam passing through must then bring it down.
   std::vector<Vec3> burst(40, false_return);
   map.insert_scan(sensor, burst, {});
-  for (int scan = 0; scan < 3; ++scan) map.insert_scan(sensor, {}, {at_altitude(60.5, 0.5, 10.5)});
+  for (int scan = 0; scan < 3; ++scan)
+    map.insert_scan(sensor, {}, {point_at_altitude(60.5, 0.5, 10.5)});
   EXPECT_EQ(voxel_at(map, false_return), Voxel::kFree);
 }
 
 TEST(OccupancyMap, FreeRaysCarveUpToMaxRangeOnly) {
   OccupancyMap map(unit_config());
-  const Vec3 sensor = at_altitude(0.5, 0.5, 10.5);
-  const Vec3 removed = at_altitude(25.5, 0.5, 10.5);
+  const Vec3 sensor = point_at_altitude(0.5, 0.5, 10.5);
+  const Vec3 removed = point_at_altitude(25.5, 0.5, 10.5);
   map.insert_scan(sensor, {removed}, {});
   ASSERT_EQ(voxel_at(map, removed), Voxel::kOccupied);
   for (int scan = 0; scan < 3; ++scan)
-    map.insert_scan(sensor, {}, {at_altitude(200.5, 0.5, 10.5)});  // beyond max range
+    map.insert_scan(sensor, {}, {point_at_altitude(200.5, 0.5, 10.5)});  // beyond max range
   EXPECT_EQ(voxel_at(map, removed), Voxel::kFree);
-  EXPECT_EQ(voxel_at(map, at_altitude(55.5, 0.5, 10.5)), Voxel::kFree);
-  EXPECT_EQ(voxel_at(map, at_altitude(70.5, 0.5, 10.5)), Voxel::kUnknown);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(55.5, 0.5, 10.5)), Voxel::kFree);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(70.5, 0.5, 10.5)), Voxel::kUnknown);
 }
 
 TEST(OccupancyMap, HitsBeyondMaxRangeOnlyCarve) {
   OccupancyMap map(unit_config());
-  const Vec3 sensor = at_altitude(0.5, 0.5, 10.5);
-  map.insert_scan(sensor, {at_altitude(80.5, 0.5, 10.5)}, {});
-  EXPECT_EQ(voxel_at(map, at_altitude(80.5, 0.5, 10.5)), Voxel::kUnknown);
-  EXPECT_EQ(voxel_at(map, at_altitude(50.5, 0.5, 10.5)), Voxel::kFree);
+  const Vec3 sensor = point_at_altitude(0.5, 0.5, 10.5);
+  map.insert_scan(sensor, {point_at_altitude(80.5, 0.5, 10.5)}, {});
+  EXPECT_EQ(voxel_at(map, point_at_altitude(80.5, 0.5, 10.5)), Voxel::kUnknown);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(50.5, 0.5, 10.5)), Voxel::kFree);
 }
 
 TEST(OccupancyMap, IgnoresNonFiniteInput) {
   OccupancyMap map(unit_config());
-  map.insert_scan(Vec3(kNaN, 0, -10), {at_altitude(5.5, 0.5, 10.5)}, {});
+  map.insert_scan(Vec3(kNaNCoordinate, 0, -10), {point_at_altitude(5.5, 0.5, 10.5)}, {});
   EXPECT_EQ(map.num_nodes(), 0u);
-  map.insert_scan(at_altitude(0.5, 0.5, 10.5), {Vec3(kNaN, 1, 1), at_altitude(5.5, 0.5, 10.5)},
-                  {Vec3(1, kNaN, 1)});
-  EXPECT_EQ(voxel_at(map, at_altitude(5.5, 0.5, 10.5)), Voxel::kOccupied);
-  EXPECT_LT(map.column_top(kNaN, 0.5, 0.5, 1.0, 30.0), 0.0);
+  map.insert_scan(point_at_altitude(0.5, 0.5, 10.5),
+                  {Vec3(kNaNCoordinate, 1, 1), point_at_altitude(5.5, 0.5, 10.5)},
+                  {Vec3(1, kNaNCoordinate, 1)});
+  EXPECT_EQ(voxel_at(map, point_at_altitude(5.5, 0.5, 10.5)), Voxel::kOccupied);
+  EXPECT_LT(map.column_top(kNaNCoordinate, 0.5, 0.5, 1.0, 30.0), 0.0);
   EXPECT_FALSE(map.column_seen_free(0.5, 0.5, 0.5, 30.0, 1.0));  // empty range
 }
 
 TEST(OccupancyMap, ColumnTopFindsASeenWallTopWithinOneVoxel) {
   OccupancyMap map(unit_config());
   const Wall wall{20.0, -5.0, 5.0, 12.0};
-  const Vec3 sensor = at_altitude(0.0, 0.0, 20.0);
+  const Vec3 sensor = point_at_altitude(0.0, 0.0, 20.0);
   const Scan scan = scan_of(sensor, wall, 61.0, -60.0, 10.0);
   for (int i = 0; i < 3; ++i) map.insert_scan(sensor, scan.hits, scan.free_ray_ends);
 
@@ -186,7 +188,7 @@ TEST(OccupancyMap, ColumnTopFindsASeenWallTopWithinOneVoxel) {
 TEST(OccupancyMap, TopOfATallWallSeenOnlyFromTheFaceIsNotSeenFree) {
   OccupancyMap map(unit_config());
   const Wall wall{20.0, -5.0, 5.0, 40.0};
-  const Vec3 sensor = at_altitude(0.0, 0.0, 10.0);
+  const Vec3 sensor = point_at_altitude(0.0, 0.0, 10.0);
   const Scan scan = scan_of(sensor, wall, 61.0, -15.0, 15.0);
   for (int i = 0; i < 3; ++i) map.insert_scan(sensor, scan.hits, scan.free_ray_ends);
 
@@ -200,8 +202,8 @@ TEST(OccupancyMap, TopOfATallWallSeenOnlyFromTheFaceIsNotSeenFree) {
 
 TEST(OccupancyMap, ColumnTopCanAskForMoreConfidence) {
   OccupancyMap map(unit_config());
-  const Vec3 sensor = at_altitude(0.5, 0.5, 10.5);
-  const Vec3 hit = at_altitude(20.5, 0.5, 10.5);
+  const Vec3 sensor = point_at_altitude(0.5, 0.5, 10.5);
+  const Vec3 hit = point_at_altitude(20.5, 0.5, 10.5);
   map.insert_scan(sensor, {hit}, {});  // p = 0.7
   EXPECT_DOUBLE_EQ(map.column_top(20.5, 0.5, 0.5, 1.0, 30.0), 11.0);
   EXPECT_LT(map.column_top(20.5, 0.5, 0.5, 1.0, 30.0, 0.8), 0.0);
@@ -221,27 +223,27 @@ TEST(OccupancyMap, ForgetFarDropsOnlyFarVoxels) {
   OccupancyMapConfig config = unit_config();
   config.forget_radius = 150.0;
   OccupancyMap map(config);
-  const Vec3 near_hit = at_altitude(10.5, 0.5, 10.5);
-  const Vec3 far_hit = at_altitude(220.5, 0.5, 10.5);
-  map.insert_scan(at_altitude(0.5, 0.5, 10.5), {near_hit}, {});
-  map.insert_scan(at_altitude(200.5, 0.5, 10.5), {far_hit}, {});
+  const Vec3 near_hit = point_at_altitude(10.5, 0.5, 10.5);
+  const Vec3 far_hit = point_at_altitude(220.5, 0.5, 10.5);
+  map.insert_scan(point_at_altitude(0.5, 0.5, 10.5), {near_hit}, {});
+  map.insert_scan(point_at_altitude(200.5, 0.5, 10.5), {far_hit}, {});
   const size_t before = map.num_nodes();
   map.forget_far(0.0, 0.0);
   EXPECT_EQ(voxel_at(map, near_hit), Voxel::kOccupied);
-  EXPECT_EQ(voxel_at(map, at_altitude(5.5, 0.5, 10.5)), Voxel::kFree);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(5.5, 0.5, 10.5)), Voxel::kFree);
   EXPECT_EQ(voxel_at(map, far_hit), Voxel::kUnknown);
-  EXPECT_EQ(voxel_at(map, at_altitude(205.5, 0.5, 10.5)), Voxel::kUnknown);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(205.5, 0.5, 10.5)), Voxel::kUnknown);
   EXPECT_LT(map.num_nodes(), before);
   for (auto it = map.tree().begin_leafs(), end = map.tree().end_leafs(); it != end; ++it)
     ASSERT_LE(std::hypot(it.getX(), it.getY()), 150.0) << "leaf left at " << it.getCoordinate();
 
   // The map keeps working after forgetting, also after forgetting everything.
-  map.insert_scan(at_altitude(0.5, 0.5, 10.5), {at_altitude(-12.5, 0.5, 10.5)}, {});
-  EXPECT_EQ(voxel_at(map, at_altitude(-12.5, 0.5, 10.5)), Voxel::kOccupied);
+  map.insert_scan(point_at_altitude(0.5, 0.5, 10.5), {point_at_altitude(-12.5, 0.5, 10.5)}, {});
+  EXPECT_EQ(voxel_at(map, point_at_altitude(-12.5, 0.5, 10.5)), Voxel::kOccupied);
   map.forget_far(1000.0, 1000.0);
   EXPECT_EQ(map.num_nodes(), 0u);
   EXPECT_EQ(voxel_at(map, near_hit), Voxel::kUnknown);
-  map.insert_scan(at_altitude(0.5, 0.5, 10.5), {near_hit}, {});
+  map.insert_scan(point_at_altitude(0.5, 0.5, 10.5), {near_hit}, {});
   EXPECT_EQ(voxel_at(map, near_hit), Voxel::kOccupied);
 }
 
@@ -253,8 +255,9 @@ TEST(OccupancyMap, ForgetFarKeepsAWideNeighbourhoodIntact) {
   // a point: everything known near it survives, everything far goes.
   for (int k = 0; k < 12; ++k) {
     const double a = 2.0 * kPi * k / 12.0;
-    const Vec3 sensor = at_altitude(40.0 * std::cos(a), 40.0 * std::sin(a), 10.5);
-    map.insert_scan(sensor, {at_altitude(0.5, 0.5, 10.5)}, {at_altitude(0.5, 0.5, 40.0)});
+    const Vec3 sensor = point_at_altitude(40.0 * std::cos(a), 40.0 * std::sin(a), 10.5);
+    map.insert_scan(sensor, {point_at_altitude(0.5, 0.5, 10.5)},
+                    {point_at_altitude(0.5, 0.5, 40.0)});
   }
   std::vector<Vec3> near_known;
   for (auto it = map.tree().begin_leafs(), end = map.tree().end_leafs(); it != end; ++it)
@@ -265,7 +268,7 @@ TEST(OccupancyMap, ForgetFarKeepsAWideNeighbourhoodIntact) {
   for (const Vec3& p : near_known) ASSERT_NE(voxel_at(map, p), Voxel::kUnknown);
   for (auto it = map.tree().begin_leafs(), end = map.tree().end_leafs(); it != end; ++it)
     ASSERT_LE(std::hypot(it.getX() - 5.0, it.getY() + 3.0), 30.0);
-  EXPECT_EQ(voxel_at(map, at_altitude(0.5, 0.5, 10.5)), Voxel::kOccupied);
+  EXPECT_EQ(voxel_at(map, point_at_altitude(0.5, 0.5, 10.5)), Voxel::kOccupied);
 }
 
 TEST(OccupancyMap, ForgetFarKeepsEveryLeafWithinTheRadiusUnchanged) {
@@ -276,9 +279,10 @@ TEST(OccupancyMap, ForgetFarKeepsEveryLeafWithinTheRadiusUnchanged) {
     OccupancyMap map(config);
     for (int k = 0; k < 12; ++k) {
       const double a = 2.0 * kPi * k / 12.0;
-      const Vec3 sensor = at_altitude(40.0 * std::cos(a), 40.0 * std::sin(a), 10.5);
-      map.insert_scan(sensor, {at_altitude(0.5, 0.5, 10.5), at_altitude(-8.5, 12.5, 3.5)},
-                      {at_altitude(0.5, 0.5, 40.0), at_altitude(20.5, -30.5, 1.0)});
+      const Vec3 sensor = point_at_altitude(40.0 * std::cos(a), 40.0 * std::sin(a), 10.5);
+      map.insert_scan(sensor,
+                      {point_at_altitude(0.5, 0.5, 10.5), point_at_altitude(-8.5, 12.5, 3.5)},
+                      {point_at_altitude(0.5, 0.5, 40.0), point_at_altitude(20.5, -30.5, 1.0)});
     }
     struct Leaf {
       Vec3 centre;

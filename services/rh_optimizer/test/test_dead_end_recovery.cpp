@@ -184,7 +184,7 @@ namespace ofn::rh {
 namespace {
 
 // The mission leg: north from the origin, at 36.6 m.
-const GuidanceFrame kLeg = GuidanceFrame::from_leg(Vec3(0, 0, -36.6), Vec3(150, 0, -36.6));
+const GuidanceFrame kLegFrame = GuidanceFrame::from_leg(Vec3(0, 0, -36.6), Vec3(150, 0, -36.6));
 
 RecoverySettings settings() {
   RecoverySettings s;
@@ -204,7 +204,7 @@ class RecoveryRun {
     in.position = Vec3(80, 0, -36.6);
     in.altitude = 36.6;
     in.max_vertical_speed = 1.5;
-    in.leg = kLeg;
+    in.leg = kLegFrame;
     in.route_points = &route;
   }
   RecoveryDecision step(double dt = 0.1) {
@@ -694,16 +694,16 @@ TEST(DeadEndRecovery, RouteShapes) {
   const Vec3 a(80, 0, -36.6);
   const std::vector<Vec3> out_of_u = route_out_of_the_u(a);
   // The route heads along the leg from (20, 45) on; its first corner is (20, 0).
-  const auto forward = forward_from(out_of_u, kLeg);
+  const auto forward = forward_from(out_of_u, kLegFrame);
   ASSERT_TRUE(forward);
   EXPECT_LT((out_of_u[*forward] - Vec3(20, 45, -36.6)).norm(), 1e-9);
-  const auto leg_end = escape_leg_end(out_of_u, kLeg);
+  const auto leg_end = escape_leg_end(out_of_u, kLegFrame);
   ASSERT_TRUE(leg_end);
   EXPECT_LT((out_of_u[*leg_end] - Vec3(20, 0, -36.6)).norm(), 1e-9);
   // A route straight on heads along the leg from its start.
-  EXPECT_EQ(forward_from({a, Vec3(100, 5, -36.6), Vec3(150, 0, -36.6)}, kLeg), size_t{0});
+  EXPECT_EQ(forward_from({a, Vec3(100, 5, -36.6), Vec3(150, 0, -36.6)}, kLegFrame), size_t{0});
   // Too short to say.
-  EXPECT_FALSE(forward_from({a}, kLeg));
+  EXPECT_FALSE(forward_from({a}, kLegFrame));
 }
 
 }  // namespace

@@ -14,8 +14,8 @@
 namespace ofn::rh {
 namespace {
 
-const Limits kLimits = testing_support::kBenchmarkLimits;
-constexpr double kAltitude = testing_support::kLegAltitude;
+const Limits kPlannerLimits = testing_support::kBenchmarkLimits;
+constexpr double kCruiseAltitude = testing_support::kLegAltitude;
 
 using testing_support::Box;
 using testing_support::field_with;
@@ -42,7 +42,7 @@ bool finite(const BsplineTrajectory& trajectory) {
 
 TEST(RhPlanner, SolvesACleanProblemAndWarmStartsTheNext) {
   RhPlanner planner(untimed());
-  const StepInput first = input_at(Vec3(0, 0, -kAltitude), 10.0, field_with({}));
+  const StepInput first = input_at(Vec3(0, 0, -kCruiseAltitude), 10.0, field_with({}));
   const StepOutput out = planner.step(first);
   ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
   EXPECT_EQ(out.solves, 1);
@@ -61,7 +61,7 @@ TEST(RhPlanner, SolvesACleanProblemAndWarmStartsTheNext) {
   StepInput rerouted = second;
   rerouted.time = 10.2;
   rerouted.global_path_changed = true;
-  rerouted.global_path = {Vec3(0, 0, -kAltitude), Vec3(300, 0, -kAltitude)};
+  rerouted.global_path = {Vec3(0, 0, -kCruiseAltitude), Vec3(300, 0, -kCruiseAltitude)};
   const StepOutput cold = planner.step(rerouted);
   ASSERT_EQ(cold.mode, StepMode::kSolved) << cold.reason;
   EXPECT_FALSE(cold.report.warm_started);
@@ -76,8 +76,8 @@ BsplineTrajectory quadratic(const std::vector<Vec3>& points, double duration) {
 }
 
 TEST(RhPlanner, APlanThatWaitsBeforeItMovesOffIsAStall) {
-  const Vec3 start(0, 0, -kAltitude);
-  const Vec3 far(60, 30, -kAltitude);
+  const Vec3 start(0, 0, -kCruiseAltitude);
+  const Vec3 far(60, 30, -kCruiseAltitude);
   RhProblem problem = input_at(start, 0.0, field_with({})).problem;
   problem.velocity = Vec3::Zero();
   // Hovers for the first half (three coincident points), then goes 67 m.
@@ -94,7 +94,7 @@ TEST(RhPlanner, APlanThatWaitsBeforeItMovesOffIsAStall) {
   const Vec3 near = start + Vec3(2, 0, 0);
   EXPECT_FALSE(plan_stalled(quadratic({start, start, start, near}, 20.0), problem));
   // The vehicle itself still moving: not a stall either (the plan brakes).
-  problem.velocity = Vec3(kLimits.max_speed, 0, 0);
+  problem.velocity = Vec3(kPlannerLimits.max_speed, 0, 0);
   EXPECT_FALSE(plan_stalled(waits, problem));
 }
 
@@ -107,7 +107,7 @@ TEST(RhPlanner, AShortStopFromAHoverIsSolvedColdAndMovesOffInTime) {
   // look-ahead.
   for (const double distance : {1.0, 2.0, kStallMinDisplacement + 0.1, 5.0}) {
     RhPlanner planner(untimed());
-    StepInput in = input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({}));
+    StepInput in = input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, field_with({}));
     in.problem.velocity = Vec3::Zero();
     in.problem.target = in.problem.position + Vec3(distance, 0, 0);
     in.problem.terminal_x = in.problem.frame.to_guidance(in.problem.target).x();
@@ -134,13 +134,13 @@ TEST(RhPlanner, FromAHoverAFailedRouteGuessIsTriedStraight) {
   // details: here a column stands 4 m to the side.)
   const ClearanceQuery column = field_with({{-2, 0, 4, 6, 60.0f}});
   auto hover_input = [&]() {
-    StepInput in = input_at(Vec3(0, 0, -kAltitude), 0.0, column);
+    StepInput in = input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, column);
     in.problem.velocity = Vec3::Zero();
     in.problem.target = in.problem.position + Vec3(5, 0, 0);
     in.problem.terminal_x = in.problem.frame.to_guidance(in.problem.target).x();
     in.problem.stop_at_target = true;
-    in.global_path = {Vec3(0, 0, -kAltitude), Vec3(0, 0, -kAltitude + 0.005),
-                      Vec3(5, 0, -kAltitude)};
+    in.global_path = {Vec3(0, 0, -kCruiseAltitude), Vec3(0, 0, -kCruiseAltitude + 0.005),
+                      Vec3(5, 0, -kCruiseAltitude)};
     return in;
   };
   FallbackSettings without;
@@ -170,7 +170,7 @@ TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
   // From a hover, the plan moves off at once, so the stall retry stays out
   // of the way: one solve per step.
   RhPlanner planner(untimed());
-  StepInput first = input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({}));
+  StepInput first = input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, field_with({}));
   first.problem.velocity = Vec3::Zero();
   const StepOutput out = planner.step(first);
   ASSERT_EQ(out.mode, StepMode::kSolved) << out.reason;
@@ -186,7 +186,7 @@ TEST(RhPlanner, AHealthyWarmStepFromRestSolvesOnce) {
 TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {
   RhPlanner planner(untimed());
   const ClearanceQuery open = field_with({});
-  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 5.0, open));
+  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kCruiseAltitude), 5.0, open));
   ASSERT_EQ(first.mode, StepMode::kSolved);
 
   // A terminal x out of reach within max_duration at max_speed.
@@ -204,7 +204,8 @@ TEST(RhPlanner, KeepsThePreviousWhenTheSolveFailsAndThePreviousIsSafe) {
   FallbackSettings no_retries;
   no_retries.cold_retry = false;
   RhPlanner no_retry(RhSettings{}, no_retries);
-  ASSERT_EQ(no_retry.step(input_at(Vec3(0, 0, -kAltitude), 5.0, open)).mode, StepMode::kSolved);
+  ASSERT_EQ(no_retry.step(input_at(Vec3(0, 0, -kCruiseAltitude), 5.0, open)).mode,
+            StepMode::kSolved);
   EXPECT_EQ(no_retry.step(impossible).solves, 1);
 }
 
@@ -224,7 +225,7 @@ TEST(RhPlanner, KeepsAStopAtTheWaypointToItsEndButNotAPlanStillMoving) {
   // Still at cruise speed where it ends: with 1 s left there is no time for
   // the braking after it, so brake now.
   RhPlanner passing(untimed());
-  const StepOutput moving = passing.step(input_at(Vec3(0, 0, -kAltitude), 0.0, open));
+  const StepOutput moving = passing.step(input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, open));
   ASSERT_EQ(moving.mode, StepMode::kSolved) << moving.reason;
   ASSERT_GT(moving.trajectory.velocity(moving.trajectory.duration()).norm(), 1.0);
   EXPECT_EQ(passing.step(failing_step_before_end(moving, 1.0)).mode, StepMode::kBraking);
@@ -232,7 +233,7 @@ TEST(RhPlanner, KeepsAStopAtTheWaypointToItsEndButNotAPlanStillMoving) {
   // Ending at rest on the last waypoint: it is kept to its end, and stops
   // there rather than wherever braking would.
   RhPlanner stopping;
-  StepInput last_leg = input_at(Vec3(260, 0, -kAltitude), 0.0, open);
+  StepInput last_leg = input_at(Vec3(260, 0, -kCruiseAltitude), 0.0, open);
   last_leg.problem.terminal_x = 300.0;
   last_leg.problem.stop_at_target = true;
   const StepOutput stop = stopping.step(last_leg);
@@ -249,14 +250,15 @@ TEST(RhPlanner, KeepsThePreviousWhenTheIterationLimitStopsTheSolve) {
   one_evaluation.max_iterations = 1;
   RhPlanner planner(one_evaluation);
   // Straight and level at cruise speed: the straight guess is itself feasible.
-  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+  const StepOutput first =
+      planner.step(input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, field_with({})));
   ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
 
   // A new zig-zag route: one evaluation of its guess cannot be feasible.
   StepInput later = input_at(first.trajectory.position(0.3), 0.3, field_with({}));
   later.global_path_changed = true;
-  later.global_path = {Vec3(0, 0, -kAltitude), Vec3(15, 20, -kAltitude), Vec3(30, -20, -kAltitude),
-                       Vec3(300, 0, -kAltitude)};
+  later.global_path = {Vec3(0, 0, -kCruiseAltitude), Vec3(15, 20, -kCruiseAltitude),
+                       Vec3(30, -20, -kCruiseAltitude), Vec3(300, 0, -kCruiseAltitude)};
   const StepOutput out = planner.step(later);
   EXPECT_EQ(out.mode, StepMode::kKeptPrevious) << out.reason;
   EXPECT_EQ(out.report.iterations, 1);
@@ -268,8 +270,9 @@ TEST(RhPlanner, BrakesWhenTheStartIsInsideTheClearance) {
   RhPlanner planner(untimed());
   // A tall wall 2 m ahead of the vehicle.
   const ClearanceQuery wall = field_with({{2, 4, -60, 60, 70.0f}});
-  const StepInput input = input_at(Vec3(0, 0, -kAltitude), 3.0, wall);
-  ASSERT_LT(input.problem.clearance(input.problem.position).distance, 0.5 * kLimits.clearance);
+  const StepInput input = input_at(Vec3(0, 0, -kCruiseAltitude), 3.0, wall);
+  ASSERT_LT(input.problem.clearance(input.problem.position).distance,
+            0.5 * kPlannerLimits.clearance);
   const StepOutput out = planner.step(input);
   EXPECT_EQ(out.mode, StepMode::kBraking);
   EXPECT_EQ(out.solves, 0);
@@ -282,7 +285,8 @@ TEST(RhPlanner, BrakesWhenTheStartIsInsideTheClearance) {
 
 TEST(RhPlanner, BrakesWhenThePreviousRunsIntoANewObstacle) {
   RhPlanner planner(untimed());
-  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+  const StepOutput first =
+      planner.step(input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, field_with({})));
   ASSERT_EQ(first.mode, StepMode::kSolved);
   // A wall across the whole map, higher than the field, pops up 25 m ahead:
   // no solution passes it and the previous trajectory runs into it.
@@ -306,7 +310,8 @@ TEST(RhPlanner, KeepsThePreviousPastAConflictBeyondTheBrakingWindow) {
     FallbackSettings fallback;
     fallback.short_retry = false;
     RhPlanner planner(untimed(), fallback);
-    const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+    const StepOutput first =
+        planner.step(input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, field_with({})));
     EXPECT_EQ(first.mode, StepMode::kSolved) << first.reason;
     const int north = static_cast<int>(wall_north);
     StepInput input = input_at(first.trajectory.position(0.2), 0.2,
@@ -334,7 +339,8 @@ TEST(RhPlanner, PlansToANearerXBeforeItStops) {
   FallbackSettings fallback;
   fallback.short_retry_fraction = 0.3;
   RhPlanner planner(untimed(), fallback);
-  const StepOutput first = planner.step(input_at(Vec3(0, 0, -kAltitude), 0.0, field_with({})));
+  const StepOutput first =
+      planner.step(input_at(Vec3(0, 0, -kCruiseAltitude), 0.0, field_with({})));
   ASSERT_EQ(first.mode, StepMode::kSolved) << first.reason;
   StepInput input =
       input_at(first.trajectory.position(0.2), 0.2, field_with({{30, 33, -60, 60, 200.0f}}));
@@ -346,20 +352,20 @@ TEST(RhPlanner, PlansToANearerXBeforeItStops) {
   const double x0 = input.problem.position.x();
   const double x_end = out.trajectory.position(out.trajectory.duration()).x();
   EXPECT_NEAR(x_end, x0 + 0.3 * (input.problem.terminal_x - x0), 0.5);
-  EXPECT_LT(x_end, 30.0 - kLimits.clearance);
+  EXPECT_LT(x_end, 30.0 - kPlannerLimits.clearance);
 }
 
 TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
   const FallbackSettings fallback;
   const RhPlanner planner(untimed(), fallback);
-  const double limit = fallback.braking_accel_fraction * kLimits.max_accel;
+  const double limit = fallback.braking_accel_fraction * kPlannerLimits.max_accel;
   for (const Vec3& velocity :
        {Vec3(3.0, 0, 0), Vec3(1.5, -2.0, 0.8), Vec3(0.05, 0.02, 0), Vec3(0, 0, 0)}) {
     RhProblem problem;
     problem.position = Vec3(10, -4, -25);
     problem.velocity = velocity;
     problem.acceleration = Vec3(0.3, 0.1, 0);
-    problem.limits = kLimits;
+    problem.limits = kPlannerLimits;
     const BsplineTrajectory braking = planner.braking_trajectory(problem);
     ASSERT_TRUE(finite(braking));
     EXPECT_LT((braking.position(0) - problem.position).norm(), 1e-9);
@@ -396,7 +402,7 @@ TEST(RhPlanner, BrakingTrajectoryStopsWithinTheBrakingAcceleration) {
 
 TEST(RhPlanner, NonFiniteInputBrakesWithoutNaN) {
   RhPlanner planner(untimed());
-  StepInput input = input_at(Vec3(0, 0, -kAltitude), 1.0, field_with({}));
+  StepInput input = input_at(Vec3(0, 0, -kCruiseAltitude), 1.0, field_with({}));
   input.problem.velocity.y() = std::nan("");
   const StepOutput out = planner.step(input);
   EXPECT_EQ(out.mode, StepMode::kBraking);

@@ -14,7 +14,7 @@ using testing_support::field_with;
 using testing_support::kBenchmarkLimits;
 using testing_support::kLegAltitude;
 
-const Leg kLeg{Vec3(0, 0, -kLegAltitude), Vec3(300, 0, -kLegAltitude)};
+const Leg kStraightLeg{Vec3(0, 0, -kLegAltitude), Vec3(300, 0, -kLegAltitude)};
 
 // Nothing mapped over north [-20, 180), east [-60, 60).
 mapping::Heightfield open_grid() {
@@ -39,13 +39,13 @@ FramingSettings framing(double max_shift = 3.0) {
 
 TEST(LegProblem, StartsWhereToldAndEndsAtTheSensorsReachAlongTheLeg) {
   const Vec3 vehicle(100, 1, -kLegAltitude);
-  const RhProblem p = leg_problem(kLeg, true, start_at(vehicle), vehicle, kBenchmarkLimits,
+  const RhProblem p = leg_problem(kStraightLeg, true, start_at(vehicle), vehicle, kBenchmarkLimits,
                                   field_with({}), open_grid(), framing());
   EXPECT_EQ(p.position, vehicle);
   EXPECT_EQ(p.velocity, Vec3(kBenchmarkLimits.max_speed, 0, 0));
   EXPECT_EQ(p.acceleration, Vec3(0.1, 0, 0));
-  EXPECT_EQ(p.target, kLeg.to);
-  EXPECT_NEAR(p.frame.to_guidance(kLeg.to).x(), 300.0, 1e-9);
+  EXPECT_EQ(p.target, kStraightLeg.to);
+  EXPECT_NEAR(p.frame.to_guidance(kStraightLeg.to).x(), 300.0, 1e-9);
   // Open space: the horizon is the sensor's reach from the vehicle.
   EXPECT_NEAR(p.terminal_x, 100.0 + kBenchmarkLimits.sensor_range, 1e-9);
   EXPECT_FALSE(p.stop_at_target);  // the last waypoint is beyond the horizon
@@ -55,18 +55,18 @@ TEST(LegProblem, StartsWhereToldAndEndsAtTheSensorsReachAlongTheLeg) {
 
 TEST(LegProblem, StopsAtTheTargetOnlyOnTheLastLegWithinTheHorizon) {
   const Vec3 vehicle(250, 0, -kLegAltitude);
-  const RhProblem last = leg_problem(kLeg, true, start_at(vehicle), vehicle, kBenchmarkLimits,
-                                     field_with({}), open_grid(), framing());
+  const RhProblem last = leg_problem(kStraightLeg, true, start_at(vehicle), vehicle,
+                                     kBenchmarkLimits, field_with({}), open_grid(), framing());
   EXPECT_NEAR(last.terminal_x, 300.0, 1e-9);  // never past the target
   EXPECT_TRUE(last.stop_at_target);
-  const RhProblem inner = leg_problem(kLeg, false, start_at(vehicle), vehicle, kBenchmarkLimits,
-                                      field_with({}), open_grid(), framing());
+  const RhProblem inner = leg_problem(kStraightLeg, false, start_at(vehicle), vehicle,
+                                      kBenchmarkLimits, field_with({}), open_grid(), framing());
   EXPECT_FALSE(inner.stop_at_target);
 }
 
 TEST(FrameEscape, EndsAtTheCornerWhereThereIsRoomAndRelaxesOnlyTheForwardSpeed) {
   const Vec3 vehicle(100, 0, -kLegAltitude);
-  RhProblem p = leg_problem(kLeg, false, start_at(vehicle), vehicle, kBenchmarkLimits,
+  RhProblem p = leg_problem(kStraightLeg, false, start_at(vehicle), vehicle, kBenchmarkLimits,
                             field_with({}), open_grid(), framing());
   const Vec3 from(100, 0, -kLegAltitude), corner(80, 20, -kLegAltitude);
   const Vec3 end = frame_escape(&p, from, corner, vehicle, open_grid(), framing());
@@ -90,8 +90,8 @@ TEST(FrameEscape, MovesACrampedEndToTheNearestRoomWithinTheShiftOrKeepsTheCorner
   const double planned = kBenchmarkLimits.clearance + 0.3;
   ASSERT_LT(clearance(corner).distance, planned);
 
-  RhProblem p = leg_problem(kLeg, false, start_at(vehicle), vehicle, kBenchmarkLimits, clearance,
-                            open_grid(), framing(5.0));
+  RhProblem p = leg_problem(kStraightLeg, false, start_at(vehicle), vehicle, kBenchmarkLimits,
+                            clearance, open_grid(), framing(5.0));
   const Vec3 end = frame_escape(&p, vehicle, corner, vehicle, open_grid(), framing(5.0));
   // Room with the planned clearance and its margin, within the shift.
   EXPECT_GE(clearance(end).distance, planned + kEscapeEndMargin - 1e-3);
@@ -100,8 +100,8 @@ TEST(FrameEscape, MovesACrampedEndToTheNearestRoomWithinTheShiftOrKeepsTheCorner
 
   // No room within half a metre: the corner itself (the route check tells
   // the global planner about such corners; the escape does not invent one).
-  RhProblem q = leg_problem(kLeg, false, start_at(vehicle), vehicle, kBenchmarkLimits, clearance,
-                            open_grid(), framing(0.5));
+  RhProblem q = leg_problem(kStraightLeg, false, start_at(vehicle), vehicle, kBenchmarkLimits,
+                            clearance, open_grid(), framing(0.5));
   EXPECT_EQ(frame_escape(&q, vehicle, corner, vehicle, open_grid(), framing(0.5)), corner);
 }
 

@@ -18,7 +18,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr Utime kNavPeriod = 10000;  // 100 Hz
+constexpr Utime kPosePeriod = 10000;  // 100 Hz
 
 /// Constant velocity and yaw rate, fixed roll and pitch.
 struct Motion {
@@ -39,7 +39,7 @@ struct Motion {
 /// NAV_STATE-like samples at 100 Hz over [from, to].
 PoseBuffer poses_for(const Motion& m, Utime from, Utime to) {
   PoseBuffer buffer(10.0, 0.03);
-  for (Utime t = from; t <= to; t += kNavPeriod) buffer.insert(m.at(t));
+  for (Utime t = from; t <= to; t += kPosePeriod) buffer.insert(m.at(t));
   return buffer;
 }
 
@@ -134,8 +134,8 @@ Vec3 land(double elevation, double layer_angle, double range, const Pose& pose,
   }
   PoseBuffer poses;
   Pose before = pose, after = pose;
-  before.utime -= kNavPeriod;
-  after.utime += kNavPeriod;
+  before.utime -= kPosePeriod;
+  after.utime += kPosePeriod;
   poses.insert(before);
   poses.insert(after);
   const ScanResult r = processor.process(scan, poses);

@@ -12,12 +12,12 @@
 namespace ofn::vehicle {
 namespace {
 
-constexpr double kDt = 1.0 / 400.0;  // the simulation's physics step
+constexpr double kPhysicsStep = 1.0 / 400.0;  // the simulation's physics step
 
 /// Steps `model` for `seconds` at 400 Hz.
 void fly(RotorcraftSimulation& model, double seconds) {
-  const int steps = static_cast<int>(std::lround(seconds / kDt));
-  for (int i = 0; i < steps; ++i) model.step(kDt);
+  const int steps = static_cast<int>(std::lround(seconds / kPhysicsStep));
+  for (int i = 0; i < steps; ++i) model.step(kPhysicsStep);
 }
 
 /// A model at hover trim, commanded with the trim controls.
@@ -53,7 +53,7 @@ TEST(RotorcraftModel, HoverTrimConvergesToAnEquilibrium) {
 TEST(RotorcraftModel, HoverTrimThrustCarriesTheWeight) {
   TrimResult t;
   RotorcraftSimulation model = hovering(&t);
-  model.step(kDt);
+  model.step(kPhysicsStep);
   const auto& p = model.params();
   // Level hover: thrust equals weight to well within a percent.
   EXPECT_NEAR(model.loads().thrust, p.mass * kGravity, 0.01 * p.mass * kGravity);
@@ -201,7 +201,7 @@ TEST(RotorcraftModel, ActuatorsNeverLeaveTheirLimits) {
   const auto& p = model.params();
   model.set_command({10.0, -10.0, 10.0, -10.0});
   for (int i = 0; i < 200; ++i) {
-    model.step(kDt);
+    model.step(kPhysicsStep);
     const auto a = model.state().actuators.as_array();
     const auto lo = p.min_controls.as_array(), hi = p.max_controls.as_array();
     for (int k = 0; k < 4; ++k) {

@@ -22,7 +22,7 @@
 namespace ofn::fuzz {
 namespace {
 
-const Schema& schema() {
+const Schema& project_schema() {
   static const Schema s = Schema::parse(builtin_lcm_sources());
   return s;
 }
@@ -34,7 +34,7 @@ std::map<std::string, std::vector<std::string>> heartbeat_names() {
 }
 
 Fuzzer table_fuzzer(uint64_t seed = 1) {
-  return Fuzzer(schema(), channel_table(), message_supports(), heartbeat_names(), seed);
+  return Fuzzer(project_schema(), channel_table(), message_supports(), heartbeat_names(), seed);
 }
 
 TEST(Fuzzer, EveryChannelOfTheTableHasAGenerator) {
@@ -52,7 +52,7 @@ TEST(Fuzzer, AChannelWithoutAGeneratorStopsIt) {
   const std::vector<ChannelInfo> table = {{"NAV_STATE", "nav_state_t", 1024},
                                           {"NEW_CHANNEL", "new_thing_t", 1024}};
   try {
-    Fuzzer(schema(), table, message_supports(), {}, 1);
+    Fuzzer(project_schema(), table, message_supports(), {}, 1);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("channel NEW_CHANNEL: no fuzz generator for new_thing_t"),
@@ -61,9 +61,9 @@ TEST(Fuzzer, AChannelWithoutAGeneratorStopsIt) {
   }
   auto supports = message_supports();
   supports[0].fingerprint ^= 1;  // nav_state_t's, as if its .lcm file had changed
-  EXPECT_THROW(Fuzzer(schema(), {table[0]}, supports, {}, 1), std::runtime_error);
+  EXPECT_THROW(Fuzzer(project_schema(), {table[0]}, supports, {}, 1), std::runtime_error);
   const std::vector<ChannelInfo> family = {{"HEARTBEAT_", "heartbeat_t", 4096, true}};
-  EXPECT_THROW(Fuzzer(schema(), family, message_supports(), {}, 1), std::runtime_error);
+  EXPECT_THROW(Fuzzer(project_schema(), family, message_supports(), {}, 1), std::runtime_error);
 }
 
 TEST(Fuzzer, EveryPlaceOfEverySeedGetsEveryValueOfItsKind) {
