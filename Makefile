@@ -77,8 +77,10 @@ run: deps flight
 replay: deps flight
 	$(if $(LOG),,$(error LOG=path/to/flight.lcm or LOG=latest: the flight log to replay))deploy/watch.sh --keep --port $(PORT) --log /tmp/ofn_viewer-replay.log -- deploy/replay.sh $(LOG) --speed $(SPEED)$(if $(RERUN), --rerun $(RERUN))
 
+# ctest in two lanes: the integration tests as usual, the unit tests beside
+# them at nice 19 in the CPU the flights leave idle (tests/run_tests.sh).
 test: test-deps build
-	cd $(BUILD) && ctest --output-on-failure -j 2 --timeout 600
+	tests/run_tests.sh $(BUILD)
 
 bench: deps build
 	cmake --build $(BUILD) -j $(JOBS) --target ofn_benchmarks ofn_tracking_sweep

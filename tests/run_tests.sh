@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# `make test`'s ctest run, in two lanes side by side. The integration tests
+# run as always (ctest -j 2; those marked RUN_SERIAL alone among them). The
+# 848 unit tests run at the same time at the lowest CPU priority (nice 19),
+# so they take only the CPU the integration tests leave idle: the real-time
+# multi-process flights use about one core of two for minutes, and a unit
+# test beside them at normal priority would starve them (which is why they
+# run alone). The unit tests keep no wall-clock deadlines, so running slowly
+# does not change what they check. docs/TESTING.md has the figures.
+#
+# Usage: tests/run_tests.sh BUILD_DIR. Exit code 0 when both lanes pass,
+# 1 when a test fails, 2 on a bad command line. The unit lane's whole
+# output is in BUILD_DIR/Testing/unit_lane.log; its failures are printed.
+set -uo pipefail
+if [[ $# -ne 1 || ! -d $1 ]]; then
+  echo "usage: tests/run_tests.sh BUILD_DIR (a configured and built folder)" >&2
+  exit 2
+fi
+cd "$1" || exit 2
+mkdir -p Testing
+unit_log=Testing/unit_lane.log
+ctest_args=(--output-on-failure -j 2 --timeout 600)
+echo "tests: the unit tests run beside the integration tests at nice 19 (log: $1/$unit_log)"
+nice -n 19 ctest -L unit "${ctest_args[@]}" > "$unit_log" 2>&1 &
+unit_lane=$!
+# Ctrl-C or a kill of this script ends the unit lane too.
+trap 'kill $unit_lane 2> /dev/null' EXIT
+ctest -L integration "${ctest_args[@]}"
+integration_status=$?
+wait $unit_lane
+unit_status=$?
+trap - EXIT
+echo
+echo "== unit tests (ran beside at nice 19; all of it in $1/$unit_log):"
+if [[ $unit_status -ne 0 ]]; then
+  # What failed and why; the passing tests' lines are in the log.
+  grep -v -E '^ *Start +[0-9]+: |^ *[0-9]+/[0-9]+ Test +#[0-9]+: .* Passed ' "$unit_log"
+else
+  grep -E 'tests passed|Total Test time' "$unit_log"
+fi
+if [[ $integration_status -ne 0 || $unit_status -ne 0 ]]; then
+  echo "tests: FAILED (integration lane exit $integration_status, unit lane exit $unit_status)"
+  exit 1
+fi
+echo "tests: all passed (both lanes)"
