@@ -9,7 +9,7 @@
 # does not change what they check. docs/TESTING.md has the figures.
 #
 # Usage: tests/run_tests.sh BUILD_DIR. Exit code 0 when both lanes pass,
-# 1 when a test fails, 2 on a bad command line. The unit lane's whole
+# 1 when a test fails, 2 on a bad command line or an unlabelled test. The unit lane's whole
 # output is in BUILD_DIR/Testing/unit_lane.log; its failures are printed.
 set -uo pipefail
 if [[ $# -ne 1 || ! -d $1 ]]; then
@@ -20,6 +20,15 @@ cd "$1" || exit 2
 mkdir -p Testing
 unit_log=Testing/unit_lane.log
 ctest_args=(--output-on-failure -j 2 --timeout 600)
+# The lanes are chosen by label: a test with neither label would run in
+# neither, so it is an error here rather than a test silently left out.
+unlabelled=$(ctest -N -LE '^(unit|integration)$' | sed -n 's/^ *Test *#[0-9]*: //p')
+if [[ -n $unlabelled ]]; then
+  echo "tests: these tests have neither the unit nor the integration label" \
+    "(tests/CMakeLists.txt), so neither lane would run them:" >&2
+  echo "$unlabelled" >&2
+  exit 2
+fi
 echo "tests: the unit tests run beside the integration tests at nice 19 (log: $1/$unit_log)"
 # Nice alone is not enough: with the kernel's autogroups (Debian's default)
 # CPU is shared fairly between sessions whatever their nice values, and the
