@@ -3,7 +3,8 @@
 # has taken over in front of the wall, it is stopped (SIGSTOP) for 3 s and
 # then killed (kill -9). The controller must fly the last plan's stop and
 # hover rather than waypoint guidance into the wall; the restarted optimiser
-# takes over again. The flight must keep 0.8 R_s from the wall and finish.
+# takes over again. The flight must keep 0.8 R_s from the wall, stay in its
+# envelope (the benchmark verdict's rules) and finish.
 # The ground station's flight monitor must say the optimiser fell silent
 # (its heartbeats stop while it is stopped; the monitor here reports a
 # silence of 2 s of wall time, the default is 3) and heard again.
@@ -43,19 +44,22 @@ log=$(cat "$WORK/run/latest_log")
 "$BIN/ofn_flight_report" --log "$log" --scenario "$scenario" --out "$WORK/report" \
   > "$WORK/report.txt" || true
 cat "$WORK/report.txt"
-/usr/bin/python3 - "$WORK/report/summary.json" <<'PY' || fail "the vehicle came within 0.8 R_s or did not finish"
+/usr/bin/python3 - "$WORK/report/summary.json" <<'PY' || fail "the flight broke a rule of the verdict or did not finish"
 import json, sys
 s = json.load(open(sys.argv[1]))
 print("least clearance %.2f m (0.8 R_s = %.2f m), max speed %.2f m/s (limit %.2f m/s)" % (
     s["min_clearance"], 0.8 * s["clearance_required"], s["max_speed"], s["limits"]["max_speed"]))
 print("outcome %s %s" % (s["outcome"], "; ".join(s["failures"])))
-# What this test guards: no collision and a flight that still finishes.
-# Not the speed: resuming from the stop's hover, the controller lags the new
-# plan by up to 0.9 m and overshoots the speed limit by 14-19 % in about
-# half the runs (README, "Dense fields and trap courses"); the benchmark
-# verdict above reports it.
+# The planner's death costs neither the clearance nor the envelope: the
+# benchmark verdict's every rule (0.8 R_s, speeds and the reference's
+# acceleration within the limit + 2 %, the controller's command within its
+# bound, no reference jump) and the finish gate. Before the controller's
+# speed governor, resuming from the stop's hover overshot the speed limit
+# by 14-19 % in about half the runs; on 2026-12-03 nine runs flew at most
+# 3.07 m/s against 3.05.
 ok = s["min_clearance"] >= 0.8 * s["clearance_required"]
 ok = ok and s["crossed_finish"] and s["reached_last_waypoint"]
+ok = ok and s["outcome"] == "success" and not s["failures"]
 sys.exit(0 if ok else 1)
 PY
-pass "the optimiser stopped and killed mid-avoidance: the vehicle flew the stop, kept 0.8 R_s and finished"
+pass "the optimiser stopped and killed mid-avoidance: the vehicle flew the stop, kept 0.8 R_s and the envelope, and finished"
