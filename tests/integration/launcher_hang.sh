@@ -3,7 +3,8 @@
 # heartbeat settings): a SIGSTOPped mapper is found hung, killed and
 # restarted, and the new one is heard; then a SIGSTOPped vehicle_sim, which
 # stops every follower's heartbeats with it: only vehicle_sim is killed,
-# and the restarted one resumes the flight from its checkpoint.
+# and the restarted one resumes the flight from its checkpoint. Then, with
+# the default hang timeout, a follower stopped for 3 s is not restarted.
 source "$(dirname "$0")/common.sh"
 /usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/open.yaml" \
   --only vehicle_sim,controller,mission_uplink,mapper --bin "$BIN" --rtf 1 --no-record \
@@ -61,3 +62,39 @@ grep -Eq "mapper +onboard2 +restarts 1/5, hung 1 " "$WORK/launch.txt" ||
 grep -Eq "vehicle_sim +onboard1 +restarts 1/5, hung 1 " "$WORK/launch.txt" ||
   fail "the summary does not count vehicle_sim's hang"
 pass "a stopped mapper and a stopped vehicle_sim were found hung, killed and restarted; no follower was"
+
+# A follower stopped for 3 s is not hung: resumed, it follows the time that
+# ran on at once (SimClockGuard), so its heartbeats miss 3-4 s, under the
+# default 5 s. (Its clock used to stand 2 s more, waiting to resync, and
+# the hang watch restarted it.)
+/usr/bin/python3 "$REPO/deploy/launch.py" --scenario "$REPO/sim/scenarios/open.yaml" \
+  --only vehicle_sim,mission_uplink --bin "$BIN" --rtf 1 --no-record \
+  --log-dir "$WORK/run2" --timeout 60 --no-pin > "$WORK/launch2.txt" 2>&1 &
+launcher=$!
+trap 'stop_launcher; [[ -n ${OFN_KEEP_WORK:-} ]] || rm -rf "$WORK"' EXIT
+wait_for2() {
+  local deadline=$((SECONDS + $2))
+  until grep -q -- "$1" "$WORK/launch2.txt"; do
+    ((SECONDS < deadline)) || { tail -30 "$WORK/launch2.txt"; fail "no '$1' within $2 s"; }
+    kill -0 $launcher 2> /dev/null || { tail -30 "$WORK/launch2.txt"; fail "the launcher stopped"; }
+    sleep 0.2
+  done
+}
+wait_for2 "hang watch: .*mission_uplink (sim_clock)" 10
+sleep 3
+uplink=$(child ofn_mission_uplink)
+[[ -n $uplink ]] || fail "no mission_uplink process"
+kill -STOP "$uplink"
+echo "stopped mission_uplink (pid $uplink) for 3 s"
+sleep 3
+kill -CONT "$uplink"
+# Past the 5 s a frozen clock would have made of it (3 s + 2 s to resync).
+sleep 7
+stop_launcher
+trap '[[ -n ${OFN_KEEP_WORK:-} ]] || rm -rf "$WORK"' EXIT
+grep -q "mission_uplink is HUNG" "$WORK/launch2.txt" && fail "mission_uplink, stopped for 3 s, was found hung"
+grep -Eq "mission_uplink +[a-z0-9]+ +restarts 0/5 " "$WORK/launch2.txt" ||
+  { grep "launcher:" "$WORK/launch2.txt"; fail "mission_uplink was restarted"; }
+grep -q "SIM_CLOCK jumps ahead by .* after a silence of" "$WORK/launch2.txt" ||
+  fail "mission_uplink did not say it followed the time that ran on"
+pass "mission_uplink stopped for 3 s followed the simulation's time on its resumption and was not restarted"

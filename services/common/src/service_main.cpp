@@ -93,8 +93,9 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
   // message, so each service steps in simulation time.
   // The first node owns the subscription, so its heartbeat counts bad
   // SIM_CLOCK messages like any other input.
-  // A stamp that jumps is refused (SimClockGuard); a restarted simulation is
-  // followed once it has kept to its new time, and every timer starts afresh.
+  // A stamp that jumps is refused (SimClockGuard), unless it only makes up
+  // for a silence of this process; a restarted simulation is followed once
+  // it has kept to its new time, and every timer starts afresh.
   auto* follower = dynamic_cast<SimFollowClock*>(&clock);
   auto guard = std::make_shared<SimClockGuard>();
   if (follower && !nodes.empty()) {
@@ -110,6 +111,12 @@ int run_nodes(lcm::LCM& lcm, Clock& clock, const std::vector<Node*>& nodes,
               break;
             case SimClockGuard::Verdict::kRejected:
               nodes.front()->reject(channels::kSimClock, guard->reason());
+              break;
+            case SimClockGuard::Verdict::kCaughtUp:
+              // This process heard nothing for a while (stopped, starved,
+              // cut off): each timer fires once for the time it missed.
+              nodes.front()->log().warn("SIM_CLOCK {}: following it", guard->reason());
+              follower->update(m.utime);
               break;
             case SimClockGuard::Verdict::kResynced:
               nodes.front()->log().warn("SIM_CLOCK moved to a new timeline ({}): following it",

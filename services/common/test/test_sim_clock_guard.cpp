@@ -107,6 +107,72 @@ TEST(SimClockGuard, ARestartedFastSimulationWaitsForTheWallTimeToo) {
   EXPECT_EQ(rejected, 1000);
 }
 
+// SIM_CLOCK at 100 Hz of simulated time, `rtf` times real time.
+void feed_at(SimClockGuard& guard, Arrivals& wall, double from, double seconds, double rtf) {
+  for (int i = 0; i < static_cast<int>(seconds * 100.0); ++i)
+    ASSERT_EQ(guard.offer(to_utime(from + 0.01 * i), wall.next(0.01 / rtf)), Verdict::kAccepted)
+        << "at " << from + 0.01 * i;
+}
+
+TEST(SimClockGuard, AProcessStoppedForSecondsFollowsTheTimeThatRanOnAtOnce) {
+  // SIGSTOP for 3 s: nothing is read, then the stamp 3 s on. Waiting for the
+  // resync froze the service 2 s more and the hang watch restarted it.
+  SimClockGuard guard;
+  Arrivals wall;
+  feed_at(guard, wall, 0.0, 5.0, 1.0);
+  EXPECT_NEAR(guard.rate(), 1.0, 0.01);
+  EXPECT_EQ(guard.offer(to_utime(7.99), wall.next(3.0)), Verdict::kCaughtUp);
+  EXPECT_EQ(guard.reason(), "jumps ahead by 3.000 s after a silence of 3.000 s");
+  EXPECT_EQ(guard.followed(), to_utime(7.99));
+  feed_at(guard, wall, 8.0, 1.0, 1.0);
+}
+
+TEST(SimClockGuard, StampsQueuedDuringTheStopComeFirst) {
+  // An open bus keeps what arrived while the process was stopped: the
+  // queued stamps are read at once, then the live one, 3 s on.
+  SimClockGuard guard;
+  Arrivals wall;
+  feed_at(guard, wall, 0.0, 5.0, 1.0);
+  EXPECT_EQ(guard.offer(to_utime(5.0), wall.next(3.0)), Verdict::kAccepted);
+  for (int i = 1; i < 30; ++i)
+    ASSERT_EQ(guard.offer(to_utime(5.0 + 0.01 * i), wall.next(0.00001)), Verdict::kAccepted);
+  EXPECT_EQ(guard.offer(to_utime(8.0), wall.next(0.00001)), Verdict::kCaughtUp);
+  feed_at(guard, wall, 8.01, 1.0, 1.0);
+}
+
+TEST(SimClockGuard, ASilenceAllowsOnlyWhatTheSimulationCouldHaveRun) {
+  // At 4x real time a 3 s silence may hold 12 s of simulated time (and the
+  // margin), not 20 s, and never 1,000 s.
+  SimClockGuard guard;
+  Arrivals wall;
+  feed_at(guard, wall, 0.0, 8.0, 4.0);
+  EXPECT_NEAR(guard.rate(), 4.0, 0.05);
+  EXPECT_EQ(guard.offer(to_utime(1000.0), wall.next(3.0)), Verdict::kRejected);
+  EXPECT_EQ(guard.offer(to_utime(28.0), wall.next(0.001)), Verdict::kRejected);
+  EXPECT_EQ(guard.offer(to_utime(19.99), wall.next(0.001)), Verdict::kCaughtUp);
+}
+
+TEST(SimClockGuard, WithoutASilenceAStepOfSecondsIsStillRefused) {
+  SimClockGuard guard;
+  Arrivals wall;
+  feed_at(guard, wall, 0.0, 5.0, 1.0);
+  EXPECT_EQ(guard.offer(to_utime(7.99), wall.next(0.01)), Verdict::kRejected);
+  // Nor a second after a silence ended.
+  EXPECT_EQ(guard.offer(to_utime(5.0), wall.next(0.6)), Verdict::kAccepted);
+  feed_at(guard, wall, 5.01, 1.5, 1.0);
+  EXPECT_EQ(guard.offer(to_utime(9.0), wall.next(0.01)), Verdict::kRejected);
+}
+
+TEST(SimClockGuard, NoRateNoCatchUp) {
+  // Before a rate is measured (under 0.5 s of stamps) a silence proves
+  // nothing: the old rule, resync after keeping the new time.
+  SimClockGuard guard;
+  Arrivals wall;
+  feed_at(guard, wall, 0.0, 0.3, 1.0);
+  EXPECT_EQ(guard.rate(), 0.0);
+  EXPECT_EQ(guard.offer(to_utime(3.3), wall.next(3.0)), Verdict::kRejected);
+}
+
 TEST(SimClockGuard, TheFirstStampIsTakenWhateverItIs) {
   SimClockGuard guard;
   EXPECT_EQ(guard.followed(), INT64_MIN);
@@ -117,6 +183,8 @@ TEST(SimClockGuard, BadLimitsAreRefused) {
   EXPECT_THROW(SimClockGuard(SimClockGuardLimits{0.0, 2.0, 1.0}), std::invalid_argument);
   EXPECT_THROW(SimClockGuard(SimClockGuardLimits{1.0, -1.0, 1.0}), std::invalid_argument);
   EXPECT_THROW(SimClockGuard(SimClockGuardLimits{1.0, 2.0, -1.0}), std::invalid_argument);
+  EXPECT_THROW(SimClockGuard(SimClockGuardLimits{1.0, 2.0, 1.0, 0.0, 1.25}), std::invalid_argument);
+  EXPECT_THROW(SimClockGuard(SimClockGuardLimits{1.0, 2.0, 1.0, 0.5, 0.9}), std::invalid_argument);
 }
 
 }  // namespace
