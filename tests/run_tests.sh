@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # `make test`'s ctest run, in two lanes side by side. The integration tests
-# run as always (ctest -j 2; those marked RUN_SERIAL alone among them). The
+# run as always (ctest -j 4 in half-cores; those marked RUN_SERIAL alone). The
 # unit tests run at the same time at the lowest CPU priority (nice 19),
 # so they take only the CPU the integration tests leave idle: the real-time
 # multi-process flights use about one core of two for minutes, and a unit
