@@ -9,8 +9,9 @@
 # does not change what they check. docs/TESTING.md has the figures.
 #
 # Usage: tests/run_tests.sh BUILD_DIR. Exit code 0 when both lanes pass,
-# 1 when a test fails, 2 on a bad command line or an unlabelled test. The unit lane's whole
-# output is in BUILD_DIR/Testing/unit_lane.log; its failures are printed.
+# 1 when a test fails, 2 on a bad command line or an unlabelled test. The
+# unit lane's whole output is in BUILD_DIR/Testing/unit_lane.log; its
+# failures are printed.
 set -uo pipefail
 if [[ $# -ne 1 || ! -d $1 ]]; then
   echo "usage: tests/run_tests.sh BUILD_DIR (a configured and built folder)" >&2
@@ -19,7 +20,7 @@ fi
 cd "$1" || exit 2
 mkdir -p Testing
 unit_log=Testing/unit_lane.log
-ctest_args=(--output-on-failure -j 2 --timeout 600)
+ctest_args=(--output-on-failure --timeout 600)
 # The lanes are chosen by label: a test with neither label would run in
 # neither, so it is an error here rather than a test silently left out.
 unlabelled=$(ctest -N -LE '^(unit|integration)$' | sed -n 's/^ *Test *#[0-9]*: //p')
@@ -38,14 +39,14 @@ echo "tests: the unit tests run beside the integration tests at nice 19 (log: $1
 # (a process may lower its own group's priority; without autogroups the
 # file is absent and nice 19 does it).
 setsid bash -c 'echo 19 > /proc/self/autogroup 2> /dev/null; exec nice -n 19 ctest "$@"' \
-  unit_lane -L unit "${ctest_args[@]}" > "$unit_log" 2>&1 &
+  unit_lane -L unit -j 2 "${ctest_args[@]}" > "$unit_log" 2>&1 &
 unit_lane=$!
 # Ctrl-C or a kill of this script ends the unit lane (its session) too.
 trap 'kill -- -$unit_lane 2> /dev/null' EXIT
 # The integration lane counts half-cores: -j 4 on two cores, each test's
 # PROCESSORS its share (tests/CMakeLists.txt), so that a test that mostly
 # waits runs beside a busy one rather than holding a slot.
-ctest -L integration --output-on-failure -j 4 --timeout 600
+ctest -L integration -j 4 "${ctest_args[@]}"
 integration_status=$?
 wait $unit_lane
 unit_status=$?

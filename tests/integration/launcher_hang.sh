@@ -14,12 +14,13 @@ stop_launcher() { kill -INT $launcher 2> /dev/null || true; wait $launcher || tr
 trap 'stop_launcher; [[ -n ${OFN_KEEP_WORK:-} ]] || rm -rf "$WORK"' EXIT
 # This launcher's own child (tests side by side share the PID namespace).
 child() { pgrep -P $launcher -f "$BIN/$1" | head -1; }
-# Waits up to $2 s for a line matching $1 in the launcher's output.
+# Waits up to $2 s for a line matching $1 in the launcher's output ($out).
+out="$WORK/launch.txt"
 wait_for() {
   local deadline=$((SECONDS + $2))
-  until grep -q -- "$1" "$WORK/launch.txt"; do
-    ((SECONDS < deadline)) || { tail -30 "$WORK/launch.txt"; fail "no '$1' within $2 s"; }
-    kill -0 $launcher 2> /dev/null || { tail -30 "$WORK/launch.txt"; fail "the launcher stopped"; }
+  until grep -q -- "$1" "$out"; do
+    ((SECONDS < deadline)) || { tail -30 "$out"; fail "no '$1' within $2 s"; }
+    kill -0 $launcher 2> /dev/null || { tail -30 "$out"; fail "the launcher stopped"; }
     sleep 0.2
   done
 }
@@ -72,15 +73,8 @@ pass "a stopped mapper and a stopped vehicle_sim were found hung, killed and res
   --log-dir "$WORK/run2" --timeout 60 --no-pin > "$WORK/launch2.txt" 2>&1 &
 launcher=$!
 trap 'stop_launcher; [[ -n ${OFN_KEEP_WORK:-} ]] || rm -rf "$WORK"' EXIT
-wait_for2() {
-  local deadline=$((SECONDS + $2))
-  until grep -q -- "$1" "$WORK/launch2.txt"; do
-    ((SECONDS < deadline)) || { tail -30 "$WORK/launch2.txt"; fail "no '$1' within $2 s"; }
-    kill -0 $launcher 2> /dev/null || { tail -30 "$WORK/launch2.txt"; fail "the launcher stopped"; }
-    sleep 0.2
-  done
-}
-wait_for2 "hang watch: .*mission_uplink (sim_clock)" 10
+out="$WORK/launch2.txt"
+wait_for "hang watch: .*mission_uplink (sim_clock)" 10
 sleep 3
 uplink=$(child ofn_mission_uplink)
 [[ -n $uplink ]] || fail "no mission_uplink process"
