@@ -170,6 +170,7 @@ RhOptimizerServiceConfig load_rh_optimizer_config(YamlReader& r) {
   b.short_retry_fraction = f.number_in("short_retry_fraction", b.short_retry_fraction, 0.05, 0.95);
   b.hover_retry = f.boolean("hover_retry", b.hover_retry);
   b.hover_retry_speed = f.number_in("hover_retry_speed", b.hover_retry_speed, 0.0, 5.0);
+  b.braking_retry_period = f.number_in("braking_retry_period", b.braking_retry_period, 0.0, 10.0);
   b.climb_fraction = f.number_in("climb_fraction", b.climb_fraction, 0.1, 1.0);
   f.finish();
 

@@ -74,6 +74,8 @@ void RhPlanner::reset() {
   previous_start_ = 0;
   climb_ = BsplineTrajectory();
   climb_start_ = 0;
+  braking_ = false;
+  last_braking_retry_ = -std::numeric_limits<double>::infinity();
 }
 
 BsplineTrajectory vertical_move(const Vec3& from, double to_z, double max_speed, double max_accel) {
@@ -120,7 +122,10 @@ StepOutput RhPlanner::brake(const StepInput& input, StepOutput out, const std::s
   out.trajectory = braking_trajectory(input.problem);
   out.start_time = std::isfinite(input.time) ? input.time : 0.0;
   out.reason = why;
+  const double last_retry = last_braking_retry_;
   reset();
+  braking_ = true;
+  last_braking_retry_ = last_retry;
   return out;
 }
 
@@ -158,6 +163,7 @@ StepOutput RhPlanner::climb(const StepInput& input, double target_z) {
   out.trajectory = climb_;
   out.start_time = climb_start_;
   out.reason = "climbing";
+  braking_ = false;
   return out;
 }
 
@@ -326,12 +332,19 @@ StepOutput RhPlanner::step(const StepInput& input) {
     ++out.solves;
     accepted = committable(out.report);
   }
-  if (!accepted && fallback_.hover_retry && !input.global_path.empty() &&
+  // While a stop is flown, the retries below wait for their period (the
+  // step's own solve above runs every step).
+  // (1 us short of it counts: steps of 0.1 s add up in floating point.)
+  const bool retries_due =
+      !braking_ || !(input.time - last_braking_retry_ < fallback_.braking_retry_period - 1e-6);
+  bool retried = false;
+  if (!accepted && retries_due && fallback_.hover_retry && !input.global_path.empty() &&
       problem.velocity.norm() < fallback_.hover_retry_speed) {
     // The route's guess failed (warm, then cold, or cold alone) from a
     // hover: once more from the straight one (FallbackSettings::hover_retry).
     SolveReport straight = optimizer_.solve(problem, RhOptimizer::guess_straight(problem));
     ++out.solves;
+    retried = true;
     if (committable(straight)) {
       out.report = std::move(straight);
       accepted = true;
@@ -358,6 +371,7 @@ StepOutput RhPlanner::step(const StepInput& input) {
     out.start_time = input.time;
     previous_ = out.report.trajectory;
     previous_start_ = input.time;
+    braking_ = false;
     return out;
   }
 
@@ -373,7 +387,8 @@ StepOutput RhPlanner::step(const StepInput& input) {
   // is known to run into something later (it only puts off the stop); a
   // previous plan clear to its end is the better of the two.
   auto nearer = [&](const std::string& why) {
-    if (!fallback_.short_retry || problem.stop_at_target) return false;
+    if (!fallback_.short_retry || problem.stop_at_target || !retries_due) return false;
+    retried = true;
     RhProblem closer = problem;
     const double x0 = problem.frame.to_guidance(problem.position).x();
     closer.terminal_x = x0 + fallback_.short_retry_fraction * (problem.terminal_x - x0);
@@ -390,10 +405,13 @@ StepOutput RhPlanner::step(const StepInput& input) {
     out.reason = why + "; flying a plan to a nearer x instead";
     previous_ = out.report.trajectory;
     previous_start_ = input.time;
+    braking_ = false;
     return true;
   };
   auto nearer_or_brake = [&](const std::string& why) {
     if (nearer(why)) return out;
+    // The period counts from a step whose retries ran and failed.
+    if (retried) last_braking_retry_ = input.time;
     return brake(why);
   };
   if (!has_previous()) return nearer_or_brake(failure + "; no previous trajectory");

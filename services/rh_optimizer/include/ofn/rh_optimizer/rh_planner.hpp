@@ -7,6 +7,7 @@
 // that brake to a hover. Pure core, time in seconds of the
 // caller's clock.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,14 @@ struct FallbackSettings {
   bool hover_retry = true;
   double hover_retry_speed = 0.3;     // m/s: a start this slow counts as a hover
   double short_retry_fraction = 0.5;  // of the way from the vehicle to the terminal x
+  /// s: while a stop is flown (braking, then its hover) the retries above
+  /// (hover_retry, short_retry) run at most this often; the step's own
+  /// solve still runs every step. A stop changes the problem slowly, and
+  /// each failing solve runs to the time cap: three per step doubled the
+  /// lockstep runner's CPU wherever the vehicle brakes (bench1 with unseen
+  /// space near the vehicle taken as obstacle, docs/TUNING.md). 0: every
+  /// step.
+  double braking_retry_period = 0.5;
   double climb_fraction = 0.8;  // of the vertical speed and acceleration limits a climb flies at
   // A climb starts only from a hover this still (the commit gate's start tolerances).
   double climb_start_speed = 0.05;  // m/s
@@ -136,6 +145,10 @@ class RhPlanner {
   double previous_start_ = 0;
   BsplineTrajectory climb_;  // the climb flown (empty: none)
   double climb_start_ = 0;   // s, clock time of its t = 0
+  // A stop of brake() is flown (no plan of our own since): the retries
+  // follow braking_retry_period. Cleared by a solved step and by reset().
+  bool braking_ = false;
+  double last_braking_retry_ = -std::numeric_limits<double>::infinity();  // s, clock time
 };
 
 }  // namespace ofn::rh
