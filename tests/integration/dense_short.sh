@@ -17,11 +17,14 @@
 # and reach the goal. Out of the yard there is only the way over a wall:
 # after a look that finds no route the recovery climbs to look over them;
 # the vehicle must have crossed the start gate, outside the yard, by 160 s.
-# Dense seed 158 gets stuck in front of a gap its global route runs
-# through and its RH optimiser cannot fly: the optimiser must have told the
-# planner of at least one such passage (NARROW_PASSAGES) by 100 s.
+# Dense seed 24 gets stuck in front of gaps its global route runs through
+# and its RH optimiser cannot fly: the optimiser must have told the planner
+# of at least one such passage (NARROW_PASSAGES) by 100 s (7 on
+# 2026-12-03; seed 158, the field of this check before, has flown past its
+# gap without stopping since unseen space near the vehicle counts as
+# obstacle).
 source "$(dirname "$0")/common.sh"
-SEEDS="1 158"
+SEEDS="1 24"
 # Simulated seconds per flight: the course takes 60 s unobstructed and the
 # avoidance happens within the first 100 s; a flight that stops hovers until
 # the scenario's 200 s limit, which would cost minutes of wall time for
@@ -98,7 +101,7 @@ for name in names:
         if outcome != "success":
             print("%s: %s, but a route exists round the outside" % (name, outcome))
             ok = False
-    if name == "dense-158" and s.get("narrow_passages", 0) < 1:
+    if name == "dense-24" and s.get("narrow_passages", 0) < 1:
         print("%s: no passage too narrow to fly was told to the planner" % name)
         ok = False
     if name == "trap_yard" and s.get("gate_start_t") is None:

@@ -107,7 +107,13 @@ class RhOptimizerServiceTest : public ::testing::Test {
   }
   static RhOptimizerServiceConfig config() {
     auto reader = YamlReader::empty("(defaults)");
-    return load_rh_optimizer_config(reader);
+    RhOptimizerServiceConfig c = load_rh_optimizer_config(reader);
+    // No SCAN_WORLD is sent here, so every cell is unseen, and the ring of
+    // unseen cells near the vehicle (on by default) would close the way
+    // at once; these tests are of the grid's obstacles (the ring's own:
+    // RhOptimizerServiceUnseen below).
+    c.unseen_near_reach = 0.0;
+    return c;
   }
   void deliver() { bus_.deliver(); }
   void advance_to(Utime t) { bus_.advance_to(service_.node(), t); }
@@ -148,6 +154,35 @@ TEST(RhOptimizerConfigReader, AnUnseenRingWhoseExemptDiscCoversItIsRefused) {
   EXPECT_THROW(load("unseen_near_reach: 5.0\nunseen_near_exempt: 6.0\n"), ConfigError);
   EXPECT_THROW(load("unseen_near_reach: 5.0\nunseen_near_exempt: 5.0\n"), ConfigError);
   std::remove(path.c_str());
+}
+
+// The default config takes unseen cells 4-10 m from the vehicle as
+// obstacle. With no scan ever received, nothing beside the vehicle has been
+// seen: the open way ahead engages avoidance, and what is flown is a stop.
+TEST(RhOptimizerServiceUnseen, WithNoScanTheUnseenSpaceBesideTheVehicleIsNotFlownThrough) {
+  set_log_level("error");
+  testing_support::ServiceTestBus bus(kStart);
+  auto reader = YamlReader::empty("(defaults)");
+  const RhOptimizerServiceConfig config = load_rh_optimizer_config(reader);
+  ASSERT_GT(config.unseen_near_reach, 0.0);
+  RhOptimizerService service(bus.lcm(), bus.clock(), config);
+  Node listener("listener", bus.lcm(), bus.clock());
+  std::vector<ref_traj_t> trajs;
+  listener.subscribe<ref_traj_t>(channels::kRefTraj,
+                                 [&](const ref_traj_t& m) { trajs.push_back(m); });
+  bus.send(channels::kMission, mission());
+  for (int i = 0; i < 5; ++i) {
+    const Utime t = bus.now() + 50000;
+    bus.advance_to(service.node(), t);
+    bus.send(channels::kNavState,
+             nav(t, Vec3(kSpeed * 0.1 * i, 0, -kAltitude), Vec3(kSpeed, 0, 0)));
+    bus.send(channels::kObstacleGrid, grid(t, 0, 0));
+    bus.advance_to(service.node(), t + 50000);
+  }
+  set_log_level("info");
+  EXPECT_TRUE(service.engaged());
+  ASSERT_FALSE(trajs.empty());
+  EXPECT_EQ(trajs.back().mode, ref_traj_t::BRAKING);
 }
 
 TEST_F(RhOptimizerServiceTest, ClearWayAheadLeavesNominalGuidanceAlone) {

@@ -57,10 +57,11 @@ struct RhOptimizerServiceConfig {
   /// and the commit gate's stops 0.9 R_s (dense seed 412 passed an unseen
   /// cylinder at 0.78 R_s). The exempt disc keeps the vehicle's own
   /// position outside them: its cell squares stay more than 0.5 R_s away,
-  /// where the optimiser still solves (start_inside_fraction). Off by
-  /// default: at 10 m every flight starts by braking to look round itself,
-  /// and the lockstep runner takes twice the CPU (docs/TUNING.md).
-  double unseen_near_reach = 0.0;
+  /// where the optimiser still solves (start_inside_fraction). At 10 m
+  /// every flight starts by braking to look round itself (the scanner has
+  /// seen a narrow wedge ahead), and the lockstep runner takes about twice
+  /// the CPU (docs/TUNING.md).
+  double unseen_near_reach = 10.0;
   double unseen_near_exempt = 4.0;
   bool planned_initial_acceleration = true;  // a(t0) from the last plan, not the nav solution
   /// Position and velocity at t0 from the last plan too, while the vehicle
