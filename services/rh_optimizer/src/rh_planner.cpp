@@ -334,9 +334,11 @@ StepOutput RhPlanner::step(const StepInput& input) {
   }
   // While a stop is flown, the retries below wait for their period (the
   // step's own solve above runs every step).
-  // (1 us short of it counts: steps of 0.1 s add up in floating point.)
+  // (1 us short of it counts: steps of 0.1 s add up in floating point; a
+  // clock that went back counts as due.)
+  const double since_retry = input.time - last_braking_retry_;
   const bool retries_due =
-      !braking_ || !(input.time - last_braking_retry_ < fallback_.braking_retry_period - 1e-6);
+      !braking_ || !(since_retry >= 0 && since_retry < fallback_.braking_retry_period - 1e-6);
   bool retried = false;
   if (!accepted && retries_due && fallback_.hover_retry && !input.global_path.empty() &&
       problem.velocity.norm() < fallback_.hover_retry_speed) {
