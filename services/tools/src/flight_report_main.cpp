@@ -8,7 +8,7 @@
 
 #include "ofn/common/config.hpp"
 #include "ofn/common/service_main.hpp"
-#include "ofn/controller/controller_service.hpp"
+#include "ofn/controller/controller_config.hpp"
 #include "ofn/tools/flight_report.hpp"
 
 int main(int argc, char** argv) {
