@@ -19,6 +19,17 @@ script, in the run's own namespaces only:
                           (the launcher restarts it)
   stop-SERVICE            SIGSTOP of the service for 3 s, then SIGCONT
   starve-onboard2         a busy process on onboard2's core for 10 s
+  delay-20/50/100         every link between hosts delays each frame by 20 ms
+                          +- 5, 50 ms +- 20 or 100 ms +- 20 (jitter that
+                          reorders), the whole flight
+  duplicate-10            every link sends 10 % of the frames twice
+  reorder-10              every link delays frames by 20 ms and sends 10 %
+                          at once, ahead of them
+
+The last five go through bench/link_relay.py in the bridge's namespace (a
+user-space link: packet sockets on the bridge's ports, the bridge told to
+drop what the relay forwards), stopped when the ground station's run ends;
+its counts are in the row's "applied" and in OUT/<name>/relay.json.
 
 Every flight is judged by the benchmark rules (ofn_flight_report: true speed
 and clearance, the verdict success / safe stop / failure). Writes
@@ -27,10 +38,9 @@ Progress is printed per row. Exit code 1 when any row's outcome is failure,
 2 for bad arguments. Needs root (network namespaces) and nftables
 (`make faults` installs it).
 
-Delay, jitter, duplication and reordering between hosts are not in the
-suite: this kernel has neither sch_netem nor nftables' queue statement, so
-they would need a user-space relay between the host namespaces, which the
-project does not have (docs/TESTING.md#the-fault-suite).
+This kernel has neither sch_netem nor nftables' queue statement: hence
+the user-space relay for delay, jitter, duplication and reordering
+(docs/TESTING.md#the-fault-suite).
 """
 import datetime
 import json
@@ -51,6 +61,10 @@ import campaign_report as cr  # noqa: E402
 
 PROG = "bench/fault_suite.py"
 FLY3 = os.path.join(REPO, "deploy", "fly_three_hosts.sh")
+RELAY = os.path.join(HERE, "link_relay.py")
+# fly_three_hosts.sh's hosts, and the names of their ports on its bridge.
+HOSTS = ("gcs", "onboard1", "onboard2")
+ENDED = "the ground station's run ended"
 
 sys.path.insert(0, os.path.join(REPO, "deploy"))
 import launch  # noqa: E402
@@ -99,6 +113,14 @@ def rows():
         table["stop-" + service] = ("SIGSTOP " + service + " for 3 s", "engaged", ("stop", service))
     table["starve-onboard2"] = ("busy process on onboard2's core for 10 s", "engaged",
                                 ("starve", "onboard2"))
+    for delay_ms, jitter_ms in ((20, 5), (50, 20), (100, 20)):
+        table["delay-%d" % delay_ms] = (
+            "%d ms +- %d ms delay on every link" % (delay_ms, jitter_ms), "start",
+            ("relay", ["--delay", str(delay_ms / 1000.0), "--jitter", str(jitter_ms / 1000.0)]))
+    table["duplicate-10"] = ("10 % of frames duplicated on every link", "start",
+                             ("relay", ["--duplicate", "0.1"]))
+    table["reorder-10"] = ("20 ms delay, 10 % of frames sent ahead, on every link", "start",
+                           ("relay", ["--delay", "0.02", "--reorder", "0.1"]))
     return table
 
 
@@ -110,6 +132,8 @@ class Run:
         self.lines = []
         self.tag = None
         self.engaged = threading.Event()
+        self.ended = threading.Event()  # the ground station's run has ended
+        self.relay_done = None  # a thread that stops the link relay at the end
         cmd = [FLY3, "--scenario", args.scenario, "--rtf", str(args.rtf), "--out", out_dir,
                "--timeout", str(args.timeout), "--bin", args.bin]
         if args.open_bus:
@@ -129,6 +153,9 @@ class Run:
                 self.tag = m.group(1)
             if ENGAGED in line:
                 self.engaged.set()
+            if ENDED in line:
+                self.ended.set()
+        self.ended.set()
         self.output.close()
 
     def namespace(self, host):
@@ -179,6 +206,8 @@ def apply(run, action):
         time.sleep(value)
         nft(run, ["flush", "chain", "bridge", "ofn_faults", "forward"])
         return "onboard2 -> onboard1 cut for %.1f s" % value
+    if kind == "relay":
+        return start_relay(run, value)
     if kind in ("kill", "stop"):
         pids = run.pids(spec_of(value).host, comm_of(value))
         if not pids:
@@ -206,6 +235,47 @@ def apply(run, action):
         busy.wait()
         return "busy loop on core %d in %s for 10 s" % (core, value)
     raise ValueError(kind)
+
+
+def start_relay(run, options):
+    """bench/link_relay.py on every link between the hosts, in the bridge's
+    namespace, until the ground station's run ends (before the hosts'
+    namespaces go). Its last line of counts is kept in run.relay_summary."""
+    stats = os.path.join(run.out_dir, "relay.json")
+    log = open(os.path.join(run.out_dir, "relay.txt"), "w")
+    relay = subprocess.Popen(["ip", "netns", "exec", run.namespace("bridge"), "/usr/bin/python3",
+                              RELAY, "--ports", ",".join(HOSTS), "--stats", stats] + options,
+                             stdout=log, stderr=subprocess.STDOUT)
+    started = time.monotonic()
+    while time.monotonic() - started < 5 and relay.poll() is None:
+        with open(log.name) as f:
+            if "link_relay: relaying" in f.read():
+                break
+        time.sleep(0.1)
+    if relay.poll() is not None:
+        log.close()
+        with open(log.name) as f:
+            raise OSError("the link relay exited with %d: %s" % (relay.returncode, f.read().strip()))
+    run.relay_summary = "the relay did not report"
+
+    def stop_at_end():
+        run.ended.wait()
+        relay.send_signal(signal.SIGTERM)
+        try:
+            relay.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            relay.kill()
+            relay.wait()
+        log.close()
+        with open(log.name) as f:
+            lines = [line.strip() for line in f if line.startswith("link_relay: ")]
+        if lines and "frames in" in lines[-1]:
+            run.relay_summary = lines[-1][len("link_relay: "):]
+
+    run.relay_done = threading.Thread(target=stop_at_end, daemon=True)
+    run.relay_done.start()
+    what = " ".join(options).replace("--", "")
+    return "relaying every link (%s)" % what
 
 
 def core_of(service):
@@ -242,6 +312,9 @@ def fly_row(name, row, args):
             "not applied: no %s" % ("namespaces" if not run.tag else trigger)
     code = run.proc.wait()
     run.reader.join()
+    if run.relay_done is not None:
+        run.relay_done.join()
+        applied += ": " + run.relay_summary
     result = {"name": name, "fault": description, "applied": applied, "exit_code": code,
               "wall_s": round(time.monotonic() - begin, 1)}
     summary_path = os.path.join(out_dir, "summary.json")
@@ -341,7 +414,8 @@ def main(argv=None):
     args.bin = cr.bin_dir(parser, args)
     if os.geteuid() != 0:
         parser.error("the hosts' network namespaces need root")
-    if shutil.which("nft") is None and any(n.startswith(("loss", "blackout")) for n in names):
+    needs_nft = ("loss", "blackout", "delay", "duplicate", "reorder")
+    if shutil.which("nft") is None and any(n.startswith(needs_nft) for n in names):
         parser.error("nft not found (apt-get install nftables, or make faults)")
     args.scenario = os.path.abspath(args.scenario)
     if not args.out:

@@ -520,6 +520,12 @@ class PythonEntryPointTest(ScratchTestCase):
                 (["--only", "no-such-row"], "unknown row", False),
                 (["--list"], "python3-yaml", True),
             ],
+            "bench/link_relay.py": [
+                (["--ports", "pa"], "--ports needs at least two ports", False),
+                (["--ports", "pa,pb", "--loss", "2"], "expected a share in [0, 1]", False),
+                (["--ports", "pa,pb", "--links", "pa:pc"], "is not FROM:TO", False),
+                (["--ports", "pa,pb", "--reorder", "0.1"], "--reorder needs a --delay", False),
+            ],
             "bench/monte_carlo.py": [
                 (["--bin", missing], "no ofn_sim_runner", False),
                 (["--bin", bin_dir, "--template", missing], "--template", False),
@@ -603,8 +609,9 @@ class PythonEntryPointTest(ScratchTestCase):
         self.assertEqual(sorted(table), sorted(self.entry_points),
                          "every Python entry point needs its bad inputs in bad_inputs()")
         for entry_point, cases in table.items():
+            # The two that import no third-party module.
             self.assertTrue(any(hidden for _, _, hidden in cases) or
-                            entry_point == "examples/python/nav_track.py",
+                            entry_point in ("examples/python/nav_track.py", "bench/link_relay.py"),
                             entry_point + ": no missing-module case")
             for args, fragment, hidden in cases:
                 with self.subTest(entry_point=entry_point, args=args):
