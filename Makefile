@@ -88,7 +88,8 @@ bench: deps build
 
 # The fault suite (docs/TESTING.md#the-fault-suite): bench3 on the three-host
 # split under each fault in turn (loss, a blackout, kill -9 and SIGSTOP of
-# every service, CPU starvation), judged and tabled. About 30 minutes; root.
+# every service, CPU starvation, delay, jitter, duplication and reordering
+# between the hosts), judged and tabled. About 40 minutes; root.
 # FAULTS=loss-30,kill-rh_optimizer flies only those rows.
 FAULTS ?=
 faults: test-deps flight
