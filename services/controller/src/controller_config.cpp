@@ -8,13 +8,11 @@
 namespace ofn::control {
 namespace {
 
-Vec3 vec(const std::vector<double>& a) {
-  return Vec3(a[0], a[1], a[2]);
-}
 // Gains per axis: three numbers, none negative (or each in [lo, hi]).
 Vec3 read_vec3(YamlReader& r, const std::string& key, const Vec3& fallback, double lo = 0.0,
                double hi = std::numeric_limits<double>::infinity()) {
-  return vec(r.numbers_in(key, {fallback.x(), fallback.y(), fallback.z()}, lo, hi));
+  const auto v = r.numbers_in(key, {fallback.x(), fallback.y(), fallback.z()}, lo, hi);
+  return Vec3(v[0], v[1], v[2]);
 }
 // Per channel: collective, longitudinal cyclic, lateral cyclic, pedal.
 vehicle::Controls read_controls(YamlReader& r, const std::string& key,
